@@ -1,0 +1,70 @@
+//! The command line: argument definitions and the commands behind them.
+//!
+//! The binary calls [`main`]; everything here is library code so the tests can drive it.
+
+pub mod raster_cmd;
+
+use std::io::{self, Write};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::raster::Target;
+
+/// Terminal 3D rasterizer with an exact edge-function core.
+#[derive(Debug, Parser)]
+#[command(name = "termrast", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Rasterize 2D triangles read from stdin (`x0 y0 x1 y1 x2 y2` per line, pixels).
+    Raster(raster_cmd::RasterArgs),
+}
+
+/// Parses `WxH` (e.g. `80x24`) into a target size.
+pub fn parse_size(s: &str) -> Result<Target, String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("size `{s}` is not WxH, e.g. 80x24"))?;
+    let side = |v: &str, name: &str| -> Result<u32, String> {
+        let n: u32 = v
+            .trim()
+            .parse()
+            .map_err(|_| format!("{name} `{v}` in size `{s}` is not a whole number"))?;
+        if n == 0 || n > crate::raster::setup::MAX_TARGET_SIDE {
+            return Err(format!(
+                "{name} {n} in size `{s}` must be between 1 and {}",
+                crate::raster::setup::MAX_TARGET_SIDE
+            ));
+        }
+        Ok(n)
+    };
+    Ok(Target::new(side(w, "width")?, side(h, "height")?))
+}
+
+/// Runs the parsed command line, writing errors to stderr.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Raster(args)) => {
+            raster_cmd::run(&args, io::stdin().lock(), io::stdout().lock())
+        }
+        None => {
+            use clap::CommandFactory;
+            let _ = Cli::command().print_help();
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let _ = writeln!(io::stderr(), "termrast: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,7 @@
+//! termrast: a terminal 3D rasterizer with an exact, SIMD edge-function core.
+//!
+//! The library holds all of the logic; the `termrast` binary only parses arguments.
+//! Start with [`raster`] for the coverage rules and conventions.
+
+pub mod cli;
+pub mod raster;

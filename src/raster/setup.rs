@@ -1,0 +1,296 @@
+//! Triangle setup: snapping, winding, edge coefficients, fill-rule bias and bounds.
+//!
+//! Everything here is computed once per triangle and shared by every traversal, the
+//! probe and the 3D pipeline, so they cannot disagree about which pixels are covered.
+
+/// Fractional bits of the vertex grid: vertices snap to 1/256 px.
+pub const SUBPIXEL_BITS: u32 = 8;
+/// One pixel in subpixel units.
+pub const SUBPIXEL_ONE: i64 = 1 << SUBPIXEL_BITS;
+/// Offset of a pixel centre from its corner, in subpixel units.
+pub const HALF_PIXEL: i64 = SUBPIXEL_ONE / 2;
+/// Largest accepted |coordinate| in pixels. With 8 subpixel bits a coordinate needs at
+/// most 29 bits, an edge delta 30, `K` and `area2` at most 60: setup never overflows `i64`.
+pub const GUARD_BAND_PX: f64 = (1u64 << 20) as f64;
+/// Largest target side in pixels; pixel centres then need at most 25 bits.
+pub const MAX_TARGET_SIDE: u32 = 1 << 16;
+
+/// Snaps a pixel-space coordinate to the subpixel grid (round to nearest, ties away
+/// from zero). `None` for NaN, infinities and anything beyond the guard band.
+#[must_use]
+#[inline]
+pub fn snap(v: f64) -> Option<i64> {
+    if v.is_finite() && v.abs() <= GUARD_BAND_PX {
+        Some((v * SUBPIXEL_ONE as f64).round() as i64)
+    } else {
+        None
+    }
+}
+
+/// The size of a render target in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Target {
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Target {
+    /// A target; sides are clamped to [`MAX_TARGET_SIDE`].
+    #[must_use]
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width: width.min(MAX_TARGET_SIDE),
+            height: height.min(MAX_TARGET_SIDE),
+        }
+    }
+
+    /// Number of pixels.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// True when the target has no pixels.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// An inclusive rectangle of pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelRect {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl PixelRect {
+    /// Whether the pixel lies inside.
+    #[must_use]
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        x >= self.x0 && x <= self.x1 && y >= self.y0 && y <= self.y1
+    }
+
+    /// Width in pixels.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.x1 - self.x0 + 1
+    }
+
+    /// Height in pixels.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.y1 - self.y0 + 1
+    }
+}
+
+/// Why a triangle produced no setup.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reject {
+    /// A coordinate was NaN or infinite.
+    NonFinite,
+    /// A coordinate lies beyond ±[`GUARD_BAND_PX`].
+    BeyondGuardBand,
+    /// The snapped vertices are collinear (zero area).
+    ZeroArea,
+    /// No pixel centre of the target lies in the triangle's bounding box.
+    Offscreen,
+}
+
+impl std::fmt::Display for Reject {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Reject::NonFinite => "non-finite coordinate",
+            Reject::BeyondGuardBand => "beyond the guard band",
+            Reject::ZeroArea => "zero area after snapping",
+            Reject::Offscreen => "no pixel centre in its bounding box",
+        })
+    }
+}
+
+/// Names of the three edge functions, in index order, as seed 000 numbers them.
+pub const EDGE_NAMES: [&str; 3] = ["F01", "F02", "F03"];
+
+/// One triangle ready for traversal.
+///
+/// Edge `e` runs from `v[e]` to `v[(e + 1) % 3]`: index 0 is `F01` (A→B), 1 is `F02`
+/// (B→C), 2 is `F03` (C→A).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Setup {
+    /// Snapped vertices A, B, C in subpixels, in positive-area order.
+    pub v: [[i64; 2]; 3],
+    /// True when the input was wound the other way and B, C were swapped.
+    pub flipped: bool,
+    /// `I0e`: change of `F0e` per subpixel step in x.
+    pub i: [i64; 3],
+    /// `J0e`: change of `F0e` per subpixel step in y.
+    pub j: [i64; 3],
+    /// `K0e`: `F0e` at the origin.
+    pub k: [i64; 3],
+    /// 0 for top and left edges, −1 for the others (the fill rule).
+    pub bias: [i64; 3],
+    /// Doubled area in subpixel² units, always > 0; equals `F01 + F02 + F03` everywhere.
+    pub area2: i64,
+    /// Pixels whose centres lie in the triangle's bounding box, clipped to the target.
+    pub bbox: PixelRect,
+}
+
+impl Setup {
+    /// Sets up a triangle given in pixel coordinates.
+    pub fn new(tri: [[f64; 2]; 3], target: Target) -> Result<Self, Reject> {
+        let mut v = [[0i64; 2]; 3];
+        for (s, p) in v.iter_mut().zip(tri) {
+            for (c, x) in s.iter_mut().zip(p) {
+                if !x.is_finite() {
+                    return Err(Reject::NonFinite);
+                }
+                *c = snap(x).ok_or(Reject::BeyondGuardBand)?;
+            }
+        }
+        Self::from_fixed(v, target)
+    }
+
+    /// Sets up a triangle whose vertices are already on the subpixel grid.
+    pub fn from_fixed(mut v: [[i64; 2]; 3], target: Target) -> Result<Self, Reject> {
+        let limit = (GUARD_BAND_PX as i64) * SUBPIXEL_ONE;
+        if v.iter().flatten().any(|c| c.abs() > limit) {
+            return Err(Reject::BeyondGuardBand);
+        }
+        let [a, b, c] = v;
+        let area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        if area2 == 0 {
+            return Err(Reject::ZeroArea);
+        }
+        let flipped = area2 < 0;
+        if flipped {
+            v.swap(1, 2);
+        }
+        let area2 = area2.abs();
+
+        let mut i = [0; 3];
+        let mut j = [0; 3];
+        let mut k = [0; 3];
+        let mut bias = [0; 3];
+        for e in 0..3 {
+            let a = v[e];
+            let b = v[(e + 1) % 3];
+            i[e] = a[1] - b[1];
+            j[e] = b[0] - a[0];
+            k[e] = a[0] * b[1] - a[1] * b[0];
+            let left = b[1] < a[1];
+            let top = b[1] == a[1] && b[0] > a[0];
+            bias[e] = if left || top { 0 } else { -1 };
+        }
+
+        let bbox = pixel_bounds(&v, target).ok_or(Reject::Offscreen)?;
+        Ok(Self {
+            v,
+            flipped,
+            i,
+            j,
+            k,
+            bias,
+            area2,
+            bbox,
+        })
+    }
+
+    /// Raw `F0e` (no fill-rule bias) at the centre of pixel `(x, y)`, evaluated directly.
+    #[must_use]
+    #[inline]
+    pub fn edge_raw(&self, e: usize, x: i64, y: i64) -> i64 {
+        let px = x * SUBPIXEL_ONE + HALF_PIXEL;
+        let py = y * SUBPIXEL_ONE + HALF_PIXEL;
+        self.i[e] * px + self.j[e] * py + self.k[e]
+    }
+
+    /// Biased `F0e` at the centre of pixel `(x, y)`: the value the traversals test `≥ 0`.
+    #[must_use]
+    #[inline]
+    pub fn edge(&self, e: usize, x: i64, y: i64) -> i64 {
+        self.edge_raw(e, x, y) + self.bias[e]
+    }
+
+    /// The three biased edge values at a pixel centre.
+    #[must_use]
+    #[inline]
+    pub fn edges(&self, x: i64, y: i64) -> [i64; 3] {
+        [self.edge(0, x, y), self.edge(1, x, y), self.edge(2, x, y)]
+    }
+
+    /// Whether the pixel centre is covered, by direct evaluation.
+    #[must_use]
+    #[inline]
+    pub fn covers(&self, x: u32, y: u32) -> bool {
+        self.bbox.contains(x, y) && self.edges(x.into(), y.into()).iter().all(|&f| f >= 0)
+    }
+
+    /// Per-pixel step of each edge function in x (`I0e` times one pixel).
+    #[must_use]
+    #[inline]
+    pub fn step_x(&self) -> [i64; 3] {
+        self.i.map(|i| i * SUBPIXEL_ONE)
+    }
+
+    /// Per-pixel step of each edge function in y (`J0e` times one pixel).
+    #[must_use]
+    #[inline]
+    pub fn step_y(&self) -> [i64; 3] {
+        self.j.map(|j| j * SUBPIXEL_ONE)
+    }
+
+    /// Largest |biased F| of any edge over the pixel rectangle `[x0, x1] × [y0, y1]`.
+    /// Edge functions are affine, so the maximum is at a corner.
+    #[must_use]
+    pub fn max_abs_edge(&self, x0: i64, y0: i64, x1: i64, y1: i64) -> u64 {
+        let mut m = 0u64;
+        for e in 0..3 {
+            for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
+                m = m.max(self.edge(e, x, y).unsigned_abs());
+            }
+        }
+        m
+    }
+
+    /// The edge values at the bbox origin, the first value every traversal starts from.
+    #[must_use]
+    #[inline]
+    pub fn edges_at_origin(&self) -> [i64; 3] {
+        self.edges(self.bbox.x0.into(), self.bbox.y0.into())
+    }
+
+    /// Maps a barycentric triple in setup order (A, B, C after any flip) back to the
+    /// caller's vertex order.
+    #[must_use]
+    #[inline]
+    pub fn unflip<T: Copy>(&self, b: [T; 3]) -> [T; 3] {
+        if self.flipped { [b[0], b[2], b[1]] } else { b }
+    }
+}
+
+/// Pixels whose centres lie within the vertices' bounding box, clipped to the target.
+fn pixel_bounds(v: &[[i64; 2]; 3], target: Target) -> Option<PixelRect> {
+    if target.is_empty() {
+        return None;
+    }
+    let lo = |c: usize| v.iter().map(|p| p[c]).min().unwrap_or(0);
+    let hi = |c: usize| v.iter().map(|p| p[c]).max().unwrap_or(0);
+    // Centre of pixel n is n*256 + 128: first centre ≥ lo, last centre ≤ hi.
+    let first = |lo: i64| (lo - HALF_PIXEL + SUBPIXEL_ONE - 1).div_euclid(SUBPIXEL_ONE);
+    let last = |hi: i64| (hi - HALF_PIXEL).div_euclid(SUBPIXEL_ONE);
+    let x0 = first(lo(0)).max(0);
+    let y0 = first(lo(1)).max(0);
+    let x1 = last(hi(0)).min(i64::from(target.width) - 1);
+    let y1 = last(hi(1)).min(i64::from(target.height) - 1);
+    if x0 > x1 || y0 > y1 {
+        return None;
+    }
+    Some(PixelRect {
+        x0: x0 as u32,
+        y0: y0 as u32,
+        x1: x1 as u32,
+        y1: y1 as u32,
+    })
+}

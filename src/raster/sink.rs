@@ -1,0 +1,120 @@
+//! Where traversals send coverage.
+//!
+//! A traversal reports covered pixels in the widest form it has: single pixels
+//! (`scalar`, `seed_simd`, partial blocks), fully covered runs (inside blocks) or 8-pixel
+//! masks (`wide`). Sinks are generic parameters, so each traversal is monomorphized
+//! for its sink and nothing is dispatched per pixel.
+
+/// Receives the pixels a traversal covers. Every pixel reported lies inside the
+/// target and the triangle's bounding box.
+pub trait CoverageSink {
+    /// Pixel `(x, y)` is covered.
+    fn pixel(&mut self, x: u32, y: u32);
+
+    /// Pixels `x0..x1` of row `y` are all covered.
+    #[inline]
+    fn span(&mut self, y: u32, x0: u32, x1: u32) {
+        for x in x0..x1 {
+            self.pixel(x, y);
+        }
+    }
+
+    /// Pixel `x0 + i` of row `y` is covered for every set bit `i` of `mask`.
+    #[inline]
+    fn mask8(&mut self, y: u32, x0: u32, mask: u8) {
+        let mut m = mask;
+        while m != 0 {
+            self.pixel(x0 + m.trailing_zeros(), y);
+            m &= m - 1;
+        }
+    }
+}
+
+/// Per-pixel coverage counts: how many triangles covered each pixel. Used for the
+/// `raster` command, for watertightness checks and as the coverage-only benchmark sink.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CountGrid {
+    pub width: u32,
+    pub height: u32,
+    /// Row-major counts.
+    pub counts: Vec<u32>,
+}
+
+impl CountGrid {
+    /// An all-zero grid.
+    #[must_use]
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            counts: vec![0; width as usize * height as usize],
+        }
+    }
+
+    /// Resets every count to zero without reallocating.
+    pub fn clear(&mut self) {
+        self.counts.fill(0);
+    }
+
+    /// Count at a pixel.
+    #[must_use]
+    pub fn get(&self, x: u32, y: u32) -> u32 {
+        self.counts[y as usize * self.width as usize + x as usize]
+    }
+
+    /// The covered pixels in row-major order.
+    pub fn covered(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        let w = self.width.max(1);
+        self.counts
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| **c > 0)
+            .map(move |(i, _)| (i as u32 % w, i as u32 / w))
+    }
+
+    #[inline]
+    fn row(&mut self, y: u32) -> &mut [u32] {
+        let w = self.width as usize;
+        let start = y as usize * w;
+        &mut self.counts[start..start + w]
+    }
+}
+
+impl CoverageSink for CountGrid {
+    #[inline]
+    fn pixel(&mut self, x: u32, y: u32) {
+        self.row(y)[x as usize] += 1;
+    }
+
+    #[inline]
+    fn span(&mut self, y: u32, x0: u32, x1: u32) {
+        for c in &mut self.row(y)[x0 as usize..x1 as usize] {
+            *c += 1;
+        }
+    }
+
+    #[inline]
+    fn mask8(&mut self, y: u32, x0: u32, mask: u8) {
+        let row = self.row(y);
+        let x0 = x0 as usize;
+        if mask == 0xFF {
+            for c in &mut row[x0..x0 + 8] {
+                *c += 1;
+            }
+        } else {
+            let mut m = mask;
+            while m != 0 {
+                row[x0 + m.trailing_zeros() as usize] += 1;
+                m &= m - 1;
+            }
+        }
+    }
+}
+
+/// Collects covered pixels in the order reported (for tests and the `cells` format).
+impl CoverageSink for Vec<(u32, u32)> {
+    #[inline]
+    fn pixel(&mut self, x: u32, y: u32) {
+        self.push((x, y));
+    }
+}

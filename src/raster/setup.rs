@@ -197,13 +197,30 @@ impl Setup {
         })
     }
 
+    /// Raw `F0e` (no fill-rule bias) at a point given in subpixel units.
+    #[must_use]
+    #[inline]
+    pub fn edge_at_subpixel(&self, e: usize, px: i64, py: i64) -> i64 {
+        self.i[e] * px + self.j[e] * py + self.k[e]
+    }
+
     /// Raw `F0e` (no fill-rule bias) at the centre of pixel `(x, y)`, evaluated directly.
     #[must_use]
     #[inline]
     pub fn edge_raw(&self, e: usize, x: i64, y: i64) -> i64 {
         let px = x * SUBPIXEL_ONE + HALF_PIXEL;
         let py = y * SUBPIXEL_ONE + HALF_PIXEL;
-        self.i[e] * px + self.j[e] * py + self.k[e]
+        self.edge_at_subpixel(e, px, py)
+    }
+
+    /// Screen-space barycentrics `(u, v, w)` of the caller's vertices A, B, C at a point in
+    /// subpixel units (seed 000 eq. 13–15: `u = F02/area2`, `v = F03/area2`,
+    /// `w = F01/area2`), exact up to the final division.
+    #[must_use]
+    pub fn barycentric_at_subpixel(&self, px: i64, py: i64) -> [f64; 3] {
+        let a = self.area2 as f64;
+        let f = [0, 1, 2].map(|e| self.edge_at_subpixel(e, px, py) as f64 / a);
+        self.unflip([f[1], f[2], f[0]])
     }
 
     /// Biased `F0e` at the centre of pixel `(x, y)`: the value the traversals test `≥ 0`.

@@ -1,0 +1,95 @@
+//! `termrast raster` end to end, through the real binary.
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+fn raster(args: &[&str], stdin: &str) -> (bool, String, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_termrast"))
+        .arg("raster")
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(stdin.as_bytes())
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    (
+        out.status.success(),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+#[test]
+fn grid_of_the_split_square() {
+    let input = "0 0 5 0 5 5\n# comment\n\n0 0 5 5 0 5\n";
+    for t in ["scalar", "seed-simd", "block", "wide"] {
+        let (ok, out, err) = raster(
+            &["--size", "6x6", "--traversal", t, "--format", "counts"],
+            input,
+        );
+        assert!(ok, "{err}");
+        assert_eq!(
+            out, "11111.\n11111.\n11111.\n11111.\n11111.\n......\n",
+            "{t}"
+        );
+    }
+    let (_, grid, _) = raster(&["--size", "6x3"], input);
+    assert_eq!(grid, "#####.\n#####.\n#####.\n");
+}
+
+#[test]
+fn cells_lists_each_triangle_on_its_own_line() {
+    let (ok, out, _) = raster(
+        &["--size", "4x4", "--format", "cells"],
+        "0 0 3 0 0 3\nnan 0 1 1 2 2\n1 1 4 1 1 4\n",
+    );
+    assert!(ok);
+    assert_eq!(out, "0,0 1,0 0,1\n\n1,1 2,1 1,2\n");
+}
+
+#[test]
+fn counts_show_overlap() {
+    // The centre (2.5, 0.5) lies on the hypotenuse, a bottom-right edge: not covered.
+    let (_, out, _) = raster(
+        &["--size", "3x1", "--format", "counts"],
+        "0 0 3 0 0 3\n0 0 3 0 0 3\n",
+    );
+    assert_eq!(out, "22.\n");
+}
+
+#[test]
+fn bad_lines_name_the_line_and_fail() {
+    let (ok, out, err) = raster(&["--size", "4x4"], "0 0 1 1 2 2\n\n1 2 3 x 5 6\n");
+    assert!(!ok);
+    assert!(out.is_empty());
+    assert!(
+        err.contains("line 3") && err.contains("`x` is not a number"),
+        "{err}"
+    );
+    let (ok, _, err) = raster(&["--size", "4x4"], "1 2 3\n");
+    assert!(
+        !ok && err.contains("line 1") && err.contains("found 3"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_arguments_are_explained() {
+    for (size, needle) in [
+        ("80", "not WxH"),
+        ("0x5", "between 1 and"),
+        ("ax5", "not a whole number"),
+    ] {
+        let (ok, _, err) = raster(&["--size", size], "");
+        assert!(!ok && err.contains(needle), "{size}: {err}");
+    }
+    let (ok, _, err) = raster(&["--traversal", "fast"], "");
+    assert!(!ok && err.contains("scalar"), "{err}");
+}

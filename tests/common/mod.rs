@@ -1,0 +1,79 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use termrast::raster::{CountGrid, CoverageSink, Setup, Target, Traversal, oracle};
+
+/// A sink that checks every reported pixel lies in the target and the bbox.
+pub struct CheckedGrid {
+    pub grid: CountGrid,
+    pub bbox: termrast::raster::PixelRect,
+}
+
+impl CoverageSink for CheckedGrid {
+    fn pixel(&mut self, x: u32, y: u32) {
+        assert!(
+            x < self.grid.width && y < self.grid.height,
+            "({x},{y}) outside target"
+        );
+        assert!(
+            self.bbox.contains(x, y),
+            "({x},{y}) outside bbox {:?}",
+            self.bbox
+        );
+        let w = self.grid.width as usize;
+        self.grid.counts[y as usize * w + x as usize] += 1;
+    }
+}
+
+/// Coverage of one triangle by one traversal, every pixel bounds-checked.
+pub fn coverage(t: Traversal, tri: [[f64; 2]; 3], target: Target) -> CountGrid {
+    let mut sink = CheckedGrid {
+        grid: CountGrid::new(target.width, target.height),
+        bbox: termrast::raster::PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: 0,
+            y1: 0,
+        },
+    };
+    if let Ok(s) = Setup::new(tri, target) {
+        sink.bbox = s.bbox;
+        t.run(&s, &mut sink);
+    }
+    sink.grid
+}
+
+/// The oracle's coverage as a 0/1 count grid.
+pub fn oracle_grid(tri: [[f64; 2]; 3], target: Target) -> CountGrid {
+    let mask = oracle::coverage(tri, target.width, target.height);
+    CountGrid {
+        width: target.width,
+        height: target.height,
+        counts: mask.into_iter().map(u32::from).collect(),
+    }
+}
+
+/// Asserts every traversal matches the oracle exactly, naming the first difference.
+pub fn assert_all_match_oracle(tri: [[f64; 2]; 3], target: Target) {
+    let want = oracle_grid(tri, target);
+    for t in Traversal::ALL {
+        let got = coverage(t, tri, target);
+        if got != want {
+            let diff = (0..want.counts.len())
+                .find(|&i| got.counts[i] != want.counts[i])
+                .map(|i| (i as u32 % target.width, i as u32 / target.width));
+            panic!(
+                "{} differs from the oracle for {tri:?} at {diff:?}",
+                t.name()
+            );
+        }
+    }
+}
+
+/// Adds one triangle's coverage (wide traversal) into a shared grid.
+pub fn accumulate(grid: &mut CountGrid, tri: [[f64; 2]; 3], t: Traversal) {
+    let target = Target::new(grid.width, grid.height);
+    if let Ok(s) = Setup::new(tri, target) {
+        t.run(&s, grid);
+    }
+}

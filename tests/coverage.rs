@@ -1,0 +1,382 @@
+//! Coverage core: the four traversals against the i128 oracle, the fill rule,
+//! watertightness, drift and hostile input.
+
+mod common;
+
+use common::{accumulate, assert_all_match_oracle, coverage, oracle_grid};
+use proptest::prelude::*;
+use termrast::raster::traverse::seed_simd_lanes;
+use termrast::raster::{CountGrid, Reject, Setup, Target, Traversal};
+
+const T: Target = Target {
+    width: 96,
+    height: 64,
+};
+
+#[test]
+fn seed_001_barycentrics() {
+    // P=(10,20), Q=(70,30), R=(60,80), p=(55,43) → (0.2, 0.5, 0.3) (seed 001).
+    let s = Setup::new(
+        [[10.0, 20.0], [70.0, 30.0], [60.0, 80.0]],
+        Target::new(128, 128),
+    )
+    .unwrap();
+    let [u, v, w] = s.barycentric_at_subpixel(55 * 256, 43 * 256);
+    assert_eq!(
+        [u, v, w],
+        [0.2, 0.5, 0.3].map(|x: f64| (x * 3100.0).round() / 3100.0)
+    );
+    assert!((u - 0.2).abs() < 1e-12 && (v - 0.5).abs() < 1e-12 && (w - 0.3).abs() < 1e-12);
+    // The other winding gives the same weights for the same vertices.
+    let f = Setup::new(
+        [[10.0, 20.0], [60.0, 80.0], [70.0, 30.0]],
+        Target::new(128, 128),
+    )
+    .unwrap();
+    assert!(f.flipped);
+    let [u2, v2, w2] = f.barycentric_at_subpixel(55 * 256, 43 * 256);
+    assert!((u2 - 0.2).abs() < 1e-12 && (v2 - 0.3).abs() < 1e-12 && (w2 - 0.5).abs() < 1e-12);
+    assert_eq!(s.area2, 3100 * 256 * 256);
+}
+
+#[test]
+fn diagonal_split_square_is_15_plus_10() {
+    let target = Target::new(8, 8);
+    // Upper-right half: the diagonal is its left edge, so it owns the 5 centres on it.
+    let upper = [[0.0, 0.0], [5.0, 0.0], [5.0, 5.0]];
+    let lower = [[0.0, 0.0], [5.0, 5.0], [0.0, 5.0]];
+    for t in Traversal::ALL {
+        let a = coverage(t, upper, target);
+        let b = coverage(t, lower, target);
+        assert_eq!(a.covered().count(), 15, "{}", t.name());
+        assert_eq!(b.covered().count(), 10, "{}", t.name());
+        for y in 0..8 {
+            for x in 0..8 {
+                let sum = a.get(x, y) + b.get(x, y);
+                assert_eq!(sum, u32::from(x < 5 && y < 5), "({x},{y}) {}", t.name());
+            }
+        }
+        assert!(
+            (0..5).all(|i| a.get(i, i) == 1),
+            "diagonal belongs to the left edge"
+        );
+    }
+}
+
+#[test]
+fn four_tiny_triangles_around_a_centre() {
+    // A 1-px diamond around the centre of pixel (3,3), split into 4 triangles meeting at
+    // m = centre + (dx, dy)/256. For every shift exactly one triangle owns the centre.
+    let target = Target::new(8, 8);
+    let c = [3.5, 3.5];
+    let ring = [
+        [c[0], c[1] - 0.5],
+        [c[0] + 0.5, c[1]],
+        [c[0], c[1] + 0.5],
+        [c[0] - 0.5, c[1]],
+    ];
+    for dx in -1..=1 {
+        for dy in -1..=1 {
+            let m = [c[0] + f64::from(dx) / 256.0, c[1] + f64::from(dy) / 256.0];
+            for t in Traversal::ALL {
+                let mut grid = CountGrid::new(8, 8);
+                for i in 0..4 {
+                    let tri = [m, ring[i], ring[(i + 1) % 4]];
+                    assert_all_match_oracle(tri, target);
+                    accumulate(&mut grid, tri, t);
+                }
+                assert_eq!(grid.get(3, 3), 1, "shift ({dx},{dy}) {}", t.name());
+                assert_eq!(grid.covered().count(), 1, "only the centre pixel");
+            }
+        }
+    }
+}
+
+/// Points along the perimeter of `[x0,x1]×[y0,y1]` (clockwise on screen), at steps of
+/// `steps[i]` subpixels, so consecutive fan triangles include many slivers.
+fn perimeter(x0: f64, y0: f64, x1: f64, y1: f64, steps: &[u32]) -> Vec<[f64; 2]> {
+    let w = x1 - x0;
+    let h = y1 - y0;
+    let total = 2.0 * (w + h);
+    let mut pts = Vec::new();
+    let mut d = 0.0;
+    let mut i = 0;
+    while d < total {
+        let p = if d < w {
+            [x0 + d, y0]
+        } else if d < w + h {
+            [x1, y0 + d - w]
+        } else if d < 2.0 * w + h {
+            [x1 - (d - w - h), y1]
+        } else {
+            [x0, y1 - (d - 2.0 * w - h)]
+        };
+        pts.push(p);
+        d += f64::from(steps[i % steps.len()]) / 256.0;
+        i += 1;
+    }
+    // The corners must be vertices for the fan to tile the rectangle exactly.
+    for c in [[x1, y0], [x1, y1], [x0, y1]] {
+        if !pts.contains(&c) {
+            let at = pts
+                .iter()
+                .position(|p| {
+                    let dist = |q: [f64; 2]| {
+                        if q[1] == y0 {
+                            q[0] - x0
+                        } else if q[0] == x1 {
+                            w + q[1] - y0
+                        } else if q[1] == y1 {
+                            w + h + x1 - q[0]
+                        } else {
+                            2.0 * w + h + y1 - q[1]
+                        }
+                    };
+                    dist(*p) > dist(c)
+                })
+                .unwrap_or(pts.len());
+            pts.insert(at, c);
+        }
+    }
+    pts
+}
+
+fn fan_counts(centre: [f64; 2], ring: &[[f64; 2]], target: Target, t: Traversal) -> CountGrid {
+    let mut grid = CountGrid::new(target.width, target.height);
+    for i in 0..ring.len() {
+        accumulate(&mut grid, [centre, ring[i], ring[(i + 1) % ring.len()]], t);
+    }
+    grid
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// Every pixel centre of the rectangle is covered exactly once, nothing outside.
+    #[test]
+    fn fan_is_watertight(
+        cx in 2.0f64..46.0, cy in 2.0f64..30.0,
+        steps in prop::collection::vec(1u32..700, 1..12),
+    ) {
+        let target = Target::new(56, 40);
+        let (x0, y0, x1, y1) = (1.0, 1.0, 47.0, 31.0);
+        let centre = [(cx * 256.0).round() / 256.0, (cy * 256.0).round() / 256.0];
+        let ring = perimeter(x0, y0, x1, y1, &steps);
+        for t in Traversal::ALL {
+            let g = fan_counts(centre, &ring, target, t);
+            for y in 0..target.height {
+                for x in 0..target.width {
+                    let inside = (1..47).contains(&x) && (1..31).contains(&y);
+                    prop_assert_eq!(g.get(x, y), u32::from(inside), "({},{}) {}", x, y, t.name());
+                }
+            }
+        }
+    }
+
+    /// The same with the fan centre far outside the target (hundreds of thousands of px).
+    #[test]
+    fn fan_with_far_centre_is_watertight(
+        cx in -400_000.0f64..-1000.0, cy in -300_000.0f64..20.0,
+        steps in prop::collection::vec(1u32..900, 1..8),
+    ) {
+        let target = Target::new(48, 32);
+        let (x0, y0, x1, y1) = (-500_000.0, -400_000.0, 40.0, 24.0);
+        let centre = [cx.round(), cy.round()];
+        // Only the part of the perimeter near the target is finely subdivided.
+        let mut ring = vec![[x0, y0], [x1, y0]];
+        ring.extend(perimeter(-8.0, -8.0, x1, y1, &steps).into_iter()
+            .filter(|p| p[0] == x1 && p[1] > -8.0 || p[1] == y1 && p[0] > -8.0 && p[0] < x1));
+        ring.push([x0, y1]);
+        for t in Traversal::ALL {
+            let g = fan_counts(centre, &ring, target, t);
+            for y in 0..target.height {
+                for x in 0..target.width {
+                    let inside = x < 40 && y < 24;
+                    prop_assert_eq!(g.get(x, y), u32::from(inside), "({},{}) {}", x, y, t.name());
+                }
+            }
+        }
+    }
+}
+
+/// A random triangle with sides from 2^-4 px to 4096 px around a random centre.
+fn triangle() -> impl Strategy<Value = [[f64; 2]; 3]> {
+    (
+        -4.0f64..12.0,
+        -40.0f64..140.0,
+        -40.0f64..100.0,
+        prop::array::uniform6(-1.0f64..1.0),
+    )
+        .prop_map(|(log_size, cx, cy, d)| {
+            let s = log_size.exp2();
+            [
+                [cx + s * d[0], cy + s * d[1]],
+                [cx + s * d[2], cy + s * d[3]],
+                [cx + s * d[4], cy + s * d[5]],
+            ]
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    #[test]
+    fn traversals_equal_oracle(tri in triangle()) {
+        assert_all_match_oracle(tri, T);
+    }
+
+    #[test]
+    fn translation_by_whole_pixels_shifts_the_mask(
+        tri in triangle(), dx in -20i32..20, dy in -20i32..20,
+    ) {
+        let big = Target::new(96, 64);
+        let moved = tri.map(|p| [p[0] + f64::from(dx), p[1] + f64::from(dy)]);
+        let a = coverage(Traversal::Wide, tri, big);
+        let b = coverage(Traversal::Wide, moved, big);
+        for y in 0..big.height as i32 {
+            for x in 0..big.width as i32 {
+                let (mx, my) = (x + dx, y + dy);
+                if (0..big.width as i32).contains(&mx) && (0..big.height as i32).contains(&my) {
+                    prop_assert_eq!(a.get(x as u32, y as u32), b.get(mx as u32, my as u32));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn collinear_triangles_cover_nothing(
+        ax in -2000i64..30000, ay in -2000i64..20000,
+        dx in -3000i64..3000, dy in -3000i64..3000, t1 in -5i64..5, t2 in -5i64..5,
+    ) {
+        let p = |t: i64| [(ax + t * dx) as f64 / 256.0, (ay + t * dy) as f64 / 256.0];
+        let tri = [p(0), p(t1), p(t2)];
+        prop_assert!(Setup::new(tri, T).is_err());
+        for t in Traversal::ALL {
+            prop_assert_eq!(coverage(t, tri, T).covered().count(), 0);
+        }
+    }
+
+    /// 1000 px long, 1/256 px wide needles at any angle.
+    #[test]
+    fn needles_match_oracle(ax in -100.0f64..150.0, ay in -100.0f64..120.0, angle in 0.0f64..6.3) {
+        let (dx, dy) = (angle.cos(), angle.sin());
+        let a = [ax, ay];
+        let b = [ax + 1000.0 * dx, ay + 1000.0 * dy];
+        let c = [b[0] - dy / 256.0, b[1] + dx / 256.0];
+        assert_all_match_oracle([a, b, c], T);
+        assert_all_match_oracle([a, c, b], T);
+    }
+
+    /// Arbitrary bit patterns: never a panic, never a pixel outside the target or bbox,
+    /// and the same answer as the oracle (which also rejects NaN, inf and huge values).
+    #[test]
+    fn arbitrary_bits_never_escape(bits in prop::array::uniform6(any::<u64>()), pick in prop::array::uniform6(0u8..4)) {
+        let v: Vec<f64> = bits.iter().zip(pick).map(|(&b, p)| match p {
+            0 => f64::from_bits(b),
+            1 => f64::from(f32::from_bits(b as u32)),
+            _ => (b % 300_000) as f64 / 256.0 - 500.0,
+        }).collect();
+        let tri = [[v[0], v[1]], [v[2], v[3]], [v[4], v[5]]];
+        assert_all_match_oracle(tri, T);
+    }
+}
+
+#[test]
+fn hostile_inputs_are_rejected_cleanly() {
+    let ok = [[1.0, 1.0], [30.0, 2.0], [4.0, 40.0]];
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        for i in 0..6 {
+            let mut t = ok;
+            t[i / 2][i % 2] = bad;
+            assert_eq!(Setup::new(t, T), Err(Reject::NonFinite));
+        }
+    }
+    let mut far = ok;
+    far[1][0] = 2_000_000.0;
+    assert_eq!(Setup::new(far, T), Err(Reject::BeyondGuardBand));
+    // Right at the guard band the triangle is exact and covers the whole target.
+    let g = termrast::raster::GUARD_BAND_PX;
+    let huge = [[-g, -g], [g, -g], [0.0, g]];
+    assert_all_match_oracle(huge, T);
+    assert_eq!(
+        coverage(Traversal::Wide, huge, T).covered().count(),
+        T.len()
+    );
+    assert_eq!(
+        Setup::new([[-5.0, -5.0], [-1.0, -5.0], [-5.0, -1.0]], T),
+        Err(Reject::Offscreen)
+    );
+}
+
+#[test]
+fn tiny_triangles_below_a_subpixel() {
+    // Smaller than 1/256 px: they snap to a point (zero area) or to one subpixel step.
+    for (x, y) in [(3.5, 3.5), (3.501, 3.499), (10.0, 2.0)] {
+        let tri = [[x, y], [x + 0.001, y], [x, y + 0.001]];
+        assert_all_match_oracle(tri, T);
+    }
+    // A 1/256 px right triangle with its corner exactly on a centre: left/top edges own it.
+    let tri = [
+        [4.5, 4.5],
+        [4.5 + 1.0 / 256.0, 4.5],
+        [4.5, 4.5 + 1.0 / 256.0],
+    ];
+    assert_all_match_oracle(tri, T);
+    assert_eq!(coverage(Traversal::Scalar, tri, T).covered().count(), 1);
+}
+
+#[test]
+fn incremental_values_equal_direct_evaluation_on_long_spans() {
+    // Rows over 4096 px long: the seed-simd lanes (stepped by adds only) equal the
+    // directly evaluated edge functions at every covered pixel, including row ends.
+    let target = Target::new(5000, 6);
+    let s = Setup::new([[0.3, 0.2], [4999.7, 1.1], [2.2, 5.9]], target).unwrap();
+    assert!(s.bbox.width() > 4096);
+    let mut last_per_row = [0u32; 6];
+    seed_simd_lanes(&s, [1.0, 0.5, 0.25], |x, y, lanes| {
+        let direct = s.edges(x.into(), y.into());
+        assert_eq!(&lanes.f[1..], &direct[..], "({x},{y})");
+        last_per_row[y as usize] = last_per_row[y as usize].max(x);
+    });
+    assert!(last_per_row.iter().any(|&x| x > 4096));
+    let wide = coverage(
+        Traversal::Wide,
+        [[0.3, 0.2], [4999.7, 1.1], [2.2, 5.9]],
+        target,
+    );
+    for (y, &x) in last_per_row.iter().enumerate() {
+        assert_eq!(wide.get(x, y as u32), 1);
+    }
+    assert_all_match_oracle([[0.3, 0.2], [4999.7, 1.1], [2.2, 5.9]], target);
+}
+
+#[test]
+fn seed_lanes_give_one_over_z_and_barycentrics() {
+    // Lane 0 is the 1/z plane: at each covered pixel, (1/z, w, u, v) from the lanes
+    // equals the perspective formula evaluated from the exact barycentrics.
+    let target = Target::new(64, 64);
+    let tri = [[3.0, 2.0], [60.0, 9.0], [20.0, 61.0]];
+    let zinv = [1.0, 0.25, 0.1];
+    let s = Setup::new(tri, target).unwrap();
+    let mut n = 0;
+    seed_simd_lanes(&s, zinv, |x, y, lanes| {
+        let [iz, w, u, v] = lanes.normalized();
+        let px = i64::from(x) * 256 + 128;
+        let py = i64::from(y) * 256 + 128;
+        let [bu, bv, bw] = s.barycentric_at_subpixel(px, py);
+        assert!((u - bu).abs() < 1e-12 && (v - bv).abs() < 1e-12 && (w - bw).abs() < 1e-12);
+        let want = bu * zinv[0] + bv * zinv[1] + bw * zinv[2];
+        assert!((iz - want).abs() < 1e-8, "1/z {iz} vs {want}");
+        n += 1;
+    });
+    assert!(n > 1000);
+}
+
+#[test]
+fn oracle_agrees_with_the_fill_rule_on_shared_edges() {
+    // The oracle itself: two triangles of a random quad never double-cover.
+    let quad = [[2.25, 3.5], [40.0, 1.0], [44.5, 30.125], [5.0, 28.0]];
+    let a = oracle_grid([quad[0], quad[1], quad[2]], T);
+    let b = oracle_grid([quad[0], quad[2], quad[3]], T);
+    assert!(a.counts.iter().zip(&b.counts).all(|(x, y)| x + y <= 1));
+}

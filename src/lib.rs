@@ -5,3 +5,4 @@
 
 pub mod cli;
 pub mod raster;
+pub mod workload;

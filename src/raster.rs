@@ -43,5 +43,5 @@ pub mod traverse;
 pub use setup::{
     EDGE_NAMES, GUARD_BAND_PX, PixelRect, Reject, SUBPIXEL_BITS, SUBPIXEL_ONE, Setup, Target, snap,
 };
-pub use sink::{CountGrid, CoverageSink};
+pub use sink::{BitMask, CountGrid, CoverageSink};
 pub use traverse::{BlockClass, Traversal};

@@ -380,3 +380,31 @@ fn oracle_agrees_with_the_fill_rule_on_shared_edges() {
     let b = oracle_grid([quad[0], quad[2], quad[3]], T);
     assert!(a.counts.iter().zip(&b.counts).all(|(x, y)| x + y <= 1));
 }
+
+#[test]
+fn benchmark_workloads_tile_exactly() {
+    // The bench workloads are themselves watertightness tests: the sliver fan and the
+    // jittered grid each cover every pixel of the target exactly once.
+    use termrast::workload::{sliver_fan, tiling};
+    let (w, h) = (320, 200);
+    for tris in [sliver_fan(700, w, h, 3), tiling(7, 4, w, h, 2)] {
+        for t in Traversal::ALL {
+            let mut g = CountGrid::new(w, h);
+            for tri in &tris {
+                accumulate(&mut g, *tri, t);
+            }
+            assert!(g.counts.iter().all(|&c| c == 1), "{}", t.name());
+        }
+    }
+}
+
+#[test]
+fn wide_takes_the_i64_path_when_i32_would_overflow() {
+    use termrast::raster::traverse::fits_i32;
+    let target = Target::new(300, 200);
+    let small = Setup::new([[1.0, 1.0], [250.0, 20.0], [30.0, 190.0]], target).unwrap();
+    let huge_tri = [[-900_000.0, -3.0], [900_000.0, 50.5], [10.0, 199.0]];
+    let huge = Setup::new(huge_tri, target).unwrap();
+    assert!(fits_i32(&small) && !fits_i32(&huge));
+    assert_all_match_oracle(huge_tri, target);
+}

@@ -1,6 +1,6 @@
 use wide::{i32x8, i64x4};
 
-use crate::raster::{CoverageSink, Setup};
+use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup};
 
 /// 8 lanes of edge values, one per pixel of a row group.
 trait Lanes: Copy {
@@ -59,28 +59,39 @@ impl Lanes for Lanes64 {
     }
 }
 
-/// Whether every value the `wide` traversal forms for this setup fits in `i32`:
-/// the edge values over the bounding box widened to whole 8-pixel groups, plus the
-/// group step `8·I`. Edge functions are affine, so checking the corners suffices.
+/// The edge values the lanes carry: `G = ⌊F / 256⌋`.
+///
+/// At pixel centres `F = 256·(I·x + J·y) + c` for a constant `c`, so `⌊F/256⌋` steps by
+/// exactly `I` per pixel and `J` per row, and `F ≥ 0 ⇔ ⌊F/256⌋ ≥ 0`. The test is
+/// unchanged bit for bit while the values are 256 times smaller, which keeps
+/// triangles up to a few thousand pixels within `i32`.
+#[inline(always)]
+fn reduced(s: &Setup) -> ([i64; 3], [i64; 3], [i64; 3]) {
+    let f = s.edges_at_origin().map(|v| v >> SUBPIXEL_BITS);
+    (f, s.i, s.j)
+}
+
+/// Whether every value the `wide` traversal forms for this setup fits in `i32`: the
+/// reduced edge values over the bounding box widened by the 7 pixels an aligned group
+/// can overhang on either side, plus the group step `8·I`. The bound is the triangle
+/// inequality from the box origin (`|G0| + |I|·(w + 14) + |J|·h`): a few operations,
+/// conservative, and cheap because tiny triangles pay it as often as they cover pixels.
 #[must_use]
 pub fn fits_i32(s: &Setup) -> bool {
     let b = s.bbox;
-    let groups = i64::from(b.width().div_ceil(8));
-    let x0 = i64::from(b.x0);
-    let x1 = x0 + groups * 8 - 1;
-    let m = s.max_abs_edge(x0, i64::from(b.y0), x1, i64::from(b.y1));
-    let step = s
-        .step_x()
-        .iter()
-        .map(|v| (v * 8).unsigned_abs())
-        .max()
-        .unwrap_or(0);
-    m.max(step) <= i32::MAX as u64
+    let (g, i, j) = reduced(s);
+    let (w, h) = (u64::from(b.width()) + 14, u64::from(b.height()));
+    (0..3).all(|e| {
+        let (ax, ay) = (i[e].unsigned_abs(), j[e].unsigned_abs());
+        g[e].unsigned_abs() + 8 * ax + ax * w + ay * h <= i32::MAX as u64
+    })
 }
 
-/// Pixel-parallel traversal: 8 pixels per step, the fast path. Row starts are stepped
-/// exactly in `i64`; within a row the lanes step by `8·I` in `i32x8` when the box
-/// allows it (almost always), else in two `i64x4`.
+/// Pixel-parallel traversal: 8 pixels per step, the fast path, on the reduced edge
+/// values `⌊F/256⌋` (see `reduced`). Row starts are stepped exactly in `i64`; each row is walked only over the range its edges allow
+/// (slivers and large triangles skip the empty part of their box), and within it the
+/// lanes step by `8·I` in `i32x8` when the box allows it (almost always), else in two
+/// `i64x4`.
 pub fn wide<S: CoverageSink>(s: &Setup, sink: &mut S) {
     if fits_i32(s) {
         walk::<i32x8, S>(s, sink);
@@ -89,30 +100,65 @@ pub fn wide<S: CoverageSink>(s: &Setup, sink: &mut S) {
     }
 }
 
+/// The pixels of one row that can pass all three edges: a conservative range (one
+/// pixel of slack on each side of the real-valued crossings), so skipping the rest is
+/// exact; the lanes still test every pixel inside it. `None` when the row is empty.
+#[inline(always)]
+fn row_range(f: [i64; 3], sx: [i64; 3], x0: u32, x1: u32) -> Option<(u32, u32)> {
+    let (mut lo, mut hi) = (f64::from(x0), f64::from(x1));
+    for e in 0..3 {
+        let (fe, se) = (f[e] as f64, sx[e] as f64);
+        if sx[e] > 0 {
+            // F(x) = f + (x − x0)·sx ≥ 0  ⇔  x ≥ x0 − f/sx
+            lo = lo.max(f64::from(x0) + (-fe / se).floor() - 1.0);
+        } else if sx[e] < 0 {
+            hi = hi.min(f64::from(x0) + (fe / -se).ceil() + 1.0);
+        } else if f[e] < 0 {
+            return None;
+        }
+    }
+    (lo <= hi).then_some((lo as u32, hi as u32))
+}
+
 #[inline(always)]
 fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
     let b = s.bbox;
-    let (sx, sy) = (s.step_x(), s.step_y());
+    let (mut row, sx, sy) = reduced(s);
     let step8 = sx.map(|v| L::splat(v * 8));
-    let mut row = s.edges_at_origin();
+    // Lane offsets `i·sx`, built once per triangle; a row start is one splat and add.
+    let ramp = sx.map(|v| L::ramp(0, v));
+    // Boxes of two groups or fewer gain nothing from the per-row range.
+    let narrow = b.width() <= 16;
     for y in b.y0..=b.y1 {
-        let mut f = [0, 1, 2].map(|e| L::ramp(row[e], sx[e]));
-        let mut x = b.x0;
-        loop {
-            let mut m = L::inside_mask(f[0], f[1], f[2]);
-            let left = b.x1 - x;
-            if left < 7 {
-                m &= (1u8 << (left + 1)) - 1;
-            }
-            if m != 0 {
-                sink.mask8(y, x, m);
-            }
-            if left < 8 {
-                break;
-            }
-            x += 8;
-            for e in 0..3 {
-                f[e] = f[e].add(step8[e]);
+        let range = if narrow {
+            Some((b.x0, b.x1))
+        } else {
+            row_range(row, sx, b.x0, b.x1)
+        };
+        if let Some((lo, hi)) = range {
+            // Groups are aligned to multiples of 8 in the target, so a sink can store
+            // a group's mask as one byte. Lanes left of the box are masked off.
+            let mut x = lo & !7;
+            let skip = i64::from(x) - i64::from(b.x0);
+            let mut f = [0, 1, 2].map(|e| L::splat(row[e] + skip * sx[e]).add(ramp[e]));
+            let mut first = !0u8 << b.x0.saturating_sub(x).min(7);
+            loop {
+                let mut m = L::inside_mask(f[0], f[1], f[2]) & first;
+                first = !0;
+                let left = hi - x;
+                if left < 7 {
+                    m &= (1u8 << (left + 1)) - 1;
+                }
+                if m != 0 {
+                    sink.mask8(y, x, m);
+                }
+                if left < 8 {
+                    break;
+                }
+                x += 8;
+                for e in 0..3 {
+                    f[e] = f[e].add(step8[e]);
+                }
             }
         }
         for e in 0..3 {

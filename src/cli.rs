@@ -3,6 +3,7 @@
 //! The binary calls [`main`]; everything here is library code so the tests can drive it.
 
 pub mod raster_cmd;
+pub mod render_cmd;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -24,6 +25,31 @@ pub struct Cli {
 pub enum Command {
     /// Rasterize 2D triangles read from stdin (`x0 y0 x1 y1 x2 y2` per line, pixels).
     Raster(raster_cmd::RasterArgs),
+    /// Render one frame of a model to a PNG file.
+    Render(render_cmd::PngArgs),
+    /// Benchmarks.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+/// `termrast bench ...`
+#[derive(Debug, Subcommand)]
+pub enum BenchCommand {
+    /// The standard scene: prints `median_ms=… min_ms=… triangles=… covered_px=… mpx_per_s=…`.
+    Render(render_cmd::BenchRenderArgs),
+}
+
+/// Errors of the commands, each naming what it is about.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    #[error(transparent)]
+    Raster(#[from] raster_cmd::RasterError),
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    #[error("{0}: {1}")]
+    Image(std::path::PathBuf, image::ImageError),
+    #[error(transparent)]
+    Io(#[from] io::Error),
 }
 
 /// Parses `WxH` (e.g. `80x24`) into a target size.
@@ -50,10 +76,13 @@ pub fn parse_size(s: &str) -> Result<Target, String> {
 /// Runs the parsed command line, writing errors to stderr.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    let result: Result<(), CliError> = match cli.command {
         Some(Command::Raster(args)) => {
-            raster_cmd::run(&args, io::stdin().lock(), io::stdout().lock())
+            raster_cmd::run(&args, io::stdin().lock(), io::stdout().lock()).map_err(Into::into)
         }
+        Some(Command::Render(args)) => render_cmd::png(&args),
+        Some(Command::Bench(BenchCommand::Render(args))) => render_cmd::bench_render(&args)
+            .and_then(|r| writeln!(io::stdout(), "{r}").map_err(Into::into)),
         None => {
             use clap::CommandFactory;
             let _ = Cli::command().print_help();

@@ -3,6 +3,9 @@
 //! The library holds all of the logic; the `termrast` binary only parses arguments.
 //! Start with [`raster`] for the coverage rules and conventions.
 
+pub mod camera;
 pub mod cli;
+pub mod mesh;
 pub mod raster;
+pub mod render;
 pub mod workload;

@@ -35,7 +35,11 @@
 //! agree bit for bit. [`oracle`] is an independent i128 reference used by the tests and
 //! the accuracy benchmark.
 
+pub mod clip;
+pub mod depth;
+pub mod interp;
 pub mod oracle;
+pub mod probe;
 pub mod setup;
 pub mod sink;
 pub mod traverse;

@@ -1,0 +1,318 @@
+//! Triangle meshes: loading OBJ files, the built-in models, normalisation and normals.
+//!
+//! Models are right-handed, y-up. [`Mesh::normalize`] centres a model on its bounding
+//! box and scales it so the largest |coordinate| is 1, which is what the standard
+//! camera (distance 2.6, 45° field of view) expects.
+
+use std::fmt;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+
+/// The Utah teapot (Martin Newell, 1975; public domain), embedded so the viewer needs
+/// no files.
+const TEAPOT_OBJ: &str = include_str!("mesh/teapot.obj");
+
+/// An indexed triangle mesh. Optional attributes are empty when absent.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Where the mesh came from, for messages and the status line.
+    pub name: String,
+    pub positions: Vec<Vec3>,
+    /// Per-vertex normals, or empty.
+    pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates, or empty.
+    pub uvs: Vec<Vec2>,
+    /// Per-vertex linear RGB colours, or empty.
+    pub colors: Vec<Vec3>,
+    /// Three indices per triangle.
+    pub indices: Vec<u32>,
+}
+
+/// Why a mesh could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}{}: {problem}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Malformed {
+        path: PathBuf,
+        line: Option<usize>,
+        problem: String,
+    },
+    #[error("{path}: no triangles")]
+    Empty { path: PathBuf },
+    #[error("unknown built-in model `{0}` (try `teapot`, `sphere:N` or an OBJ path)")]
+    UnknownBuiltin(String),
+}
+
+impl Mesh {
+    /// Number of triangles.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// The built-in Utah teapot, normalised, without normals.
+    #[must_use]
+    pub fn teapot() -> Self {
+        let mut m = parse_obj(TEAPOT_OBJ, Path::new("teapot")).expect("embedded teapot parses");
+        m.name = "teapot".into();
+        m.normalize();
+        m
+    }
+
+    /// A UV sphere of radius 1 with about `triangles` triangles (at least 8), with exact
+    /// normals and texture coordinates.
+    #[must_use]
+    pub fn uv_sphere(triangles: usize) -> Self {
+        // stacks × slices quads, 2 triangles each (the pole rows are fans of 1 each).
+        let n = ((triangles.max(8) as f64 / 4.0).sqrt().round() as u32).max(2);
+        let (stacks, slices) = (n, 2 * n);
+        let mut m = Mesh {
+            name: format!("sphere:{triangles}"),
+            ..Mesh::default()
+        };
+        for i in 0..=stacks {
+            let v = i as f32 / stacks as f32;
+            let theta = v * std::f32::consts::PI;
+            for j in 0..=slices {
+                let u = j as f32 / slices as f32;
+                let phi = u * std::f32::consts::TAU;
+                let p = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    -theta.sin() * phi.sin(),
+                );
+                m.positions.push(p);
+                m.normals.push(p);
+                m.uvs.push(Vec2::new(u, 1.0 - v));
+            }
+        }
+        let at = |i: u32, j: u32| i * (slices + 1) + j;
+        for i in 0..stacks {
+            for j in 0..slices {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                if i != 0 {
+                    m.indices.extend([a, b, d]);
+                }
+                if i != stacks - 1 {
+                    m.indices.extend([d, b, c]);
+                }
+            }
+        }
+        m
+    }
+
+    /// A model by name: `teapot`, `sphere:N`, or a path to an OBJ file.
+    pub fn from_spec(spec: &str) -> Result<Self, MeshError> {
+        if spec == "teapot" {
+            return Ok(Self::teapot());
+        }
+        if let Some(n) = spec.strip_prefix("sphere:") {
+            let n: usize = n
+                .parse()
+                .map_err(|_| MeshError::UnknownBuiltin(spec.into()))?;
+            return Ok(Self::uv_sphere(n));
+        }
+        let mut m = Self::load(Path::new(spec))?;
+        m.normalize();
+        Ok(m)
+    }
+
+    /// Loads an OBJ file (triangulated, single index), unnormalised.
+    pub fn load(path: &Path) -> Result<Self, MeshError> {
+        let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
+            path: path.into(),
+            source,
+        })?;
+        let mut m = parse_obj(&text, path)?;
+        m.name = path.display().to_string();
+        Ok(m)
+    }
+
+    /// Centres the mesh on its bounding box and scales it so max |coordinate| = 1.
+    pub fn normalize(&mut self) {
+        let (lo, hi) = self.positions.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let centre = (lo + hi) * 0.5;
+        let extent = (hi - centre).max_element();
+        let scale = if extent > 0.0 && extent.is_finite() {
+            1.0 / extent
+        } else {
+            1.0
+        };
+        for p in &mut self.positions {
+            *p = (*p - centre) * scale;
+        }
+    }
+
+    /// Generates smooth per-vertex normals (area-weighted face normals) if there are
+    /// none. Degenerate neighbourhoods fall back to +z rather than NaN.
+    pub fn ensure_normals(&mut self) {
+        if self.normals.len() == self.positions.len() {
+            return;
+        }
+        let mut n = vec![Vec3::ZERO; self.positions.len()];
+        for t in self.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.positions[i as usize]);
+            // The cross product's length is twice the area: larger faces weigh more.
+            let face = (b - a).cross(c - a);
+            for &i in t {
+                n[i as usize] += face;
+            }
+        }
+        self.normals = n
+            .into_iter()
+            .map(|v| v.try_normalize().unwrap_or(Vec3::Z))
+            .collect();
+    }
+}
+
+impl fmt::Display for Mesh {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} ({} vertices, {} triangles)",
+            self.name,
+            self.positions.len(),
+            self.triangle_count()
+        )
+    }
+}
+
+/// Parses OBJ text with tobj and merges its models into one mesh.
+fn parse_obj(text: &str, path: &Path) -> Result<Mesh, MeshError> {
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let mut reader = BufReader::new(text.as_bytes());
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed)).map_err(
+            |e| {
+                let (line, problem) = locate_error(text, e);
+                MeshError::Malformed {
+                    path: path.into(),
+                    line,
+                    problem,
+                }
+            },
+        )?;
+    let mut m = Mesh::default();
+    for model in models {
+        let mm = model.mesh;
+        let base = m.positions.len() as u32;
+        let count = mm.positions.len() / 3;
+        m.positions.extend(
+            mm.positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2])),
+        );
+        let all = |len: usize, per: usize| len == count * per && count > 0;
+        if all(mm.normals.len(), 3) {
+            m.normals.extend(
+                mm.normals
+                    .chunks_exact(3)
+                    .map(|p| Vec3::new(p[0], p[1], p[2])),
+            );
+        }
+        if all(mm.texcoords.len(), 2) {
+            m.uvs
+                .extend(mm.texcoords.chunks_exact(2).map(|p| Vec2::new(p[0], p[1])));
+        }
+        if all(mm.vertex_color.len(), 3) {
+            m.colors.extend(
+                mm.vertex_color
+                    .chunks_exact(3)
+                    .map(|p| Vec3::new(p[0], p[1], p[2])),
+            );
+        }
+        m.indices.extend(mm.indices.iter().map(|i| i + base));
+    }
+    // An attribute counts only if every model supplied it.
+    let n = m.positions.len();
+    if m.normals.len() != n {
+        m.normals.clear();
+    }
+    if m.uvs.len() != n {
+        m.uvs.clear();
+    }
+    if m.colors.len() != n {
+        m.colors.clear();
+    }
+    if let Some(bad) = m.positions.iter().position(|p| !p.is_finite()) {
+        return Err(MeshError::Malformed {
+            path: path.into(),
+            line: nth_line_starting(text, "v", bad),
+            problem: "vertex position is not a finite number".into(),
+        });
+    }
+    if m.indices.is_empty() {
+        return Err(MeshError::Empty { path: path.into() });
+    }
+    Ok(m)
+}
+
+/// Line number (1-based) of the `n`-th line whose first word is `word`.
+fn nth_line_starting(text: &str, word: &str, n: usize) -> Option<usize> {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| l.split_whitespace().next() == Some(word))
+        .nth(n)
+        .map(|(i, _)| i + 1)
+}
+
+/// tobj reports what went wrong but not where: find the first line that shows it.
+fn locate_error(text: &str, e: tobj::LoadError) -> (Option<usize>, String) {
+    use tobj::LoadError as E;
+    let floats = |rest: &[&str], min: usize| {
+        rest.len() >= min && rest.iter().all(|s| s.parse::<f32>().is_ok())
+    };
+    let counts = |t: &str| {
+        t.lines()
+            .filter(|l| l.split_whitespace().next() == Some("v"))
+            .count()
+    };
+    let nv = counts(text) as i64;
+    let bad_face = |rest: &[&str]| {
+        rest.len() < 3
+            || rest.iter().any(|c| {
+                c.split('/')
+                    .next()
+                    .and_then(|v| v.parse::<i64>().ok())
+                    .is_none_or(|i| i == 0 || i > nv || i < -nv)
+            })
+    };
+    let test = |w: &str, r: &[&str]| match e {
+        E::PositionParseError => w == "v" && !floats(r, 3),
+        E::NormalParseError => w == "vn" && !floats(r, 3),
+        E::TexcoordParseError => w == "vt" && !floats(r, 1),
+        E::FaceParseError | E::InvalidPolygon | E::FaceVertexOutOfBounds => w == "f" && bad_face(r),
+        _ => false,
+    };
+    let line = text.lines().enumerate().find_map(|(i, l)| {
+        let mut words = l.split_whitespace();
+        let w = words.next()?;
+        let rest: Vec<&str> = words.collect();
+        test(w, &rest).then_some(i + 1)
+    });
+    let what = match e {
+        E::PositionParseError => "bad vertex position (`v x y z`)".to_string(),
+        E::NormalParseError => "bad normal (`vn x y z`)".to_string(),
+        E::TexcoordParseError => "bad texture coordinate (`vt u v`)".to_string(),
+        E::FaceParseError | E::InvalidPolygon => "bad face (`f i j k ...`)".to_string(),
+        E::FaceVertexOutOfBounds => {
+            format!("face refers to a vertex that does not exist (there are {nv})")
+        }
+        other => other.to_string(),
+    };
+    (line, what)
+}

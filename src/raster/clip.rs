@@ -1,0 +1,148 @@
+//! Homogeneous clipping, before the divide by w.
+//!
+//! Triangles are clipped against the near plane (`z ≥ 0` in the directx-style clip
+//! space, i.e. `w ≥ near > 0`) and the far plane (`z ≤ w`), so only `w > 0` reaches the
+//! rasterizer and nothing behind the eye is ever drawn. x and y are left to the
+//! rasterizer's guard band: they are only clipped against planes at the guard band
+//! itself (`|x| ≤ g·w`), which a vertex crosses only when it would otherwise be
+//! rejected by setup. Everything is in fixed-size arrays: nothing is allocated.
+
+use glam::Vec4;
+
+use super::interp::Varying;
+
+/// The most vertices a triangle can have after six planes.
+pub const MAX_CLIPPED: usize = 9;
+
+/// A clip-space vertex with its varyings.
+#[derive(Clone, Copy, Debug)]
+pub struct ClipVertex<V> {
+    pub pos: Vec4,
+    pub var: V,
+}
+
+/// A convex polygon of at most [`MAX_CLIPPED`] vertices.
+#[derive(Clone, Copy, Debug)]
+pub struct Polygon<V> {
+    verts: [ClipVertex<V>; MAX_CLIPPED],
+    len: usize,
+}
+
+impl<V: Copy> Polygon<V> {
+    /// The vertices.
+    #[must_use]
+    pub fn vertices(&self) -> &[ClipVertex<V>] {
+        &self.verts[..self.len]
+    }
+
+    /// Fan triangles `(0, i, i+1)`.
+    pub fn triangles(&self) -> impl Iterator<Item = [ClipVertex<V>; 3]> + '_ {
+        (1..self.len.saturating_sub(1)).map(|i| [self.verts[0], self.verts[i], self.verts[i + 1]])
+    }
+}
+
+/// What clipping did to a triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClipOutcome {
+    /// Entirely inside every plane: draw as is.
+    Inside,
+    /// Cut by at least one plane; the polygon holds the remaining part.
+    Clipped,
+    /// Nothing left (behind the eye, beyond far, or non-finite input).
+    Rejected,
+}
+
+/// Signed distances to the clip planes (inside ≥ 0): near, far, then the guard band.
+#[inline(always)]
+fn distances(p: Vec4, guard: [f32; 2]) -> [f32; 6] {
+    [
+        p.z,
+        p.w - p.z,
+        guard[0] * p.w - p.x,
+        guard[0] * p.w + p.x,
+        guard[1] * p.w - p.y,
+        guard[1] * p.w + p.y,
+    ]
+}
+
+/// Clips a triangle. `guard` is the guard band in NDC units for x and y
+/// (see [`guard_band_ndc`]). Returns the outcome and, unless rejected, the polygon.
+pub fn clip_triangle<V: Varying>(
+    tri: [ClipVertex<V>; 3],
+    guard: [f32; 2],
+) -> (ClipOutcome, Polygon<V>) {
+    let mut poly = Polygon {
+        verts: [tri[0]; MAX_CLIPPED],
+        len: 3,
+    };
+    poly.verts[1] = tri[1];
+    poly.verts[2] = tri[2];
+    if tri.iter().any(|v| !v.pos.is_finite()) {
+        return (ClipOutcome::Rejected, poly);
+    }
+    let d = tri.map(|v| distances(v.pos, guard));
+    let mut outcome = ClipOutcome::Inside;
+    for plane in 0..6 {
+        let outside = d.iter().filter(|d| d[plane] < 0.0).count();
+        if outside == 3 {
+            return (ClipOutcome::Rejected, poly);
+        }
+        if outside > 0 {
+            outcome = ClipOutcome::Clipped;
+        }
+    }
+    // w must be positive after the near plane; w = 0 exactly on every vertex is
+    // caught here too (z ≥ 0 and z ≤ w force w ≥ 0).
+    if outcome == ClipOutcome::Inside {
+        return if tri.iter().all(|v| v.pos.w > 0.0) {
+            (outcome, poly)
+        } else {
+            (ClipOutcome::Rejected, poly)
+        };
+    }
+    for plane in 0..6 {
+        let mut out = Polygon {
+            verts: poly.verts,
+            len: 0,
+        };
+        let n = poly.len;
+        for i in 0..n {
+            let a = poly.verts[i];
+            let b = poly.verts[(i + 1) % n];
+            let da = distances(a.pos, guard)[plane];
+            let db = distances(b.pos, guard)[plane];
+            if da >= 0.0 {
+                out.verts[out.len] = a;
+                out.len += 1;
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                let t = da / (da - db);
+                out.verts[out.len] = ClipVertex {
+                    pos: a.pos + (b.pos - a.pos) * t,
+                    var: V::lerp(&a.var, &b.var, t),
+                };
+                out.len += 1;
+            }
+        }
+        poly = out;
+        if poly.len < 3 {
+            return (ClipOutcome::Rejected, poly);
+        }
+    }
+    if poly
+        .vertices()
+        .iter()
+        .any(|v| !v.pos.is_finite() || v.pos.w <= 0.0)
+    {
+        return (ClipOutcome::Rejected, poly);
+    }
+    (ClipOutcome::Clipped, poly)
+}
+
+/// The guard band in NDC units for a `width × height` target: a vertex within it maps
+/// to pixel coordinates well inside the rasterizer's ±2^20 px.
+#[must_use]
+pub fn guard_band_ndc(width: u32, height: u32) -> [f32; 2] {
+    let g = super::GUARD_BAND_PX as f32 * 0.5;
+    [g / width.max(1) as f32, g / height.max(1) as f32]
+}

@@ -1,0 +1,125 @@
+//! The probe: the raster state of one pixel, recomputed on demand.
+//!
+//! Nothing is recorded while rendering. Asked about a pixel, the probe re-runs the
+//! per-triangle preparation for every triangle in draw order, keeps those whose
+//! bounding box holds the pixel, evaluates them with the renderer's own per-pixel code
+//! and replays the depth test. Its answers therefore equal what the renderer did
+//! (the tests check every pixel of a frame).
+
+use crate::raster::Target;
+use crate::raster::depth::DEPTH_CLEAR;
+use crate::raster::interp::Varying;
+use crate::raster::traverse::{BlockClass, DEFAULT_BLOCK, block_containing, classify_block};
+use crate::render::{DrawOptions, PixelEval, Prepared, VertexCache, prepare};
+
+/// Depth-test outcome of one covered fragment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DepthOutcome {
+    /// Not covered: no test.
+    NotCovered,
+    /// Passed against the stored value.
+    Passed { against: f32 },
+    /// Failed against the stored value.
+    Failed { against: f32 },
+}
+
+/// One triangle's state at the probed pixel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeRecord<V> {
+    /// Mesh triangle index and clipped piece.
+    pub triangle: u32,
+    pub piece: u8,
+    pub clipped: bool,
+    /// Snapped vertices (subpixels, setup order) and the edge coefficients.
+    pub vertices: [[i64; 2]; 3],
+    pub i: [i64; 3],
+    pub j: [i64; 3],
+    pub k: [i64; 3],
+    pub bias: [i64; 3],
+    pub area2: i64,
+    /// Whether the input winding was flipped.
+    pub flipped: bool,
+    pub eval: PixelEval,
+    pub depth: DepthOutcome,
+    /// Classification of the pixel's block by the `block` traversal (q = 8).
+    pub block: BlockClass,
+    /// Interpolated varyings (for the shading value).
+    pub varying: V,
+}
+
+/// Everything the probe found at a pixel, in draw order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Probe<V> {
+    pub x: u32,
+    pub y: u32,
+    pub records: Vec<ProbeRecord<V>>,
+    /// Index into `records` of the fragment that is in the framebuffer, if any.
+    pub winner: Option<usize>,
+    /// The depth buffer value after the frame.
+    pub final_depth: f32,
+}
+
+/// Probes pixel `(x, y)` of a frame drawn from `cache`/`indices` with these options.
+#[must_use]
+pub fn probe<V: Varying>(
+    cache: &VertexCache<V>,
+    indices: &[u32],
+    target: Target,
+    opts: &DrawOptions,
+    x: u32,
+    y: u32,
+) -> Probe<V> {
+    let (depth_state, interpolation) = (opts.depth, opts.interpolation);
+    let mut out = Probe {
+        x,
+        y,
+        records: Vec::new(),
+        winner: None,
+        final_depth: DEPTH_CLEAR,
+    };
+    if x >= target.width || y >= target.height {
+        return out;
+    }
+    let mut stored = DEPTH_CLEAR;
+    for t in 0..(indices.len() / 3) as u32 {
+        let _ = prepare(cache, indices, t, target, opts.cull, |p: &Prepared<V>| {
+            let s = &p.setup;
+            if !s.bbox.contains(x, y) {
+                return;
+            }
+            let eval = p.eval(x, y);
+            let depth = if !eval.covered {
+                DepthOutcome::NotCovered
+            } else if depth_state.func.passes(eval.depth, stored) {
+                let against = stored;
+                if depth_state.write {
+                    stored = eval.depth;
+                }
+                out.winner = Some(out.records.len());
+                DepthOutcome::Passed { against }
+            } else {
+                DepthOutcome::Failed { against: stored }
+            };
+            let block = block_containing(s, DEFAULT_BLOCK, x, y)
+                .map_or(BlockClass::Outside, |r| classify_block(s, r));
+            out.records.push(ProbeRecord {
+                triangle: p.triangle,
+                piece: p.piece,
+                clipped: p.clipped,
+                vertices: s.v,
+                i: s.i,
+                j: s.j,
+                k: s.k,
+                bias: s.bias,
+                area2: s.area2,
+                flipped: s.flipped,
+                eval,
+                depth,
+                block,
+                varying: p.varyings(&eval, interpolation),
+            });
+        });
+    }
+    out.final_depth = stored;
+    out
+}

@@ -1,0 +1,111 @@
+//! Ready-made shaders over a [`Mesh`].
+
+use glam::{Mat3, Mat4, Vec3, Vec4};
+use wide::f32x8;
+
+use super::Shader;
+use crate::mesh::Mesh;
+
+/// The standard light direction (towards the light, world space), normalised.
+#[must_use]
+pub fn standard_light() -> Vec3 {
+    Vec3::new(0.4, 0.6, 1.0).normalize()
+}
+
+/// Per-pixel Lambert shading from interpolated normals (the benchmark scene).
+/// Varying: the world-space normal.
+#[derive(Clone, Debug)]
+pub struct Lambert<'a> {
+    pub mesh: &'a Mesh,
+    /// Model-view-projection.
+    pub mvp: Mat4,
+    /// Model rotation for normals.
+    pub normal_matrix: Mat3,
+    /// Towards the light, normalised, world space.
+    pub light: Vec3,
+    pub base: Vec3,
+    pub ambient: f32,
+}
+
+impl<'a> Lambert<'a> {
+    /// A white Lambert shader; `mesh` must have normals ([`Mesh::ensure_normals`]).
+    #[must_use]
+    pub fn new(mesh: &'a Mesh, model: Mat4, view_proj: Mat4) -> Self {
+        Self {
+            mesh,
+            mvp: view_proj * model,
+            normal_matrix: Mat3::from_mat4(model).inverse().transpose(),
+            light: standard_light(),
+            base: Vec3::ONE,
+            ambient: 0.08,
+        }
+    }
+}
+
+impl Shader for Lambert<'_> {
+    type Varying = Vec3;
+
+    #[inline(always)]
+    fn vertex(&self, index: u32) -> (Vec4, Vec3) {
+        let i = index as usize;
+        let p = self.mesh.positions[i];
+        let n = self.mesh.normals.get(i).copied().unwrap_or(Vec3::Z);
+        (self.mvp * p.extend(1.0), self.normal_matrix * n)
+    }
+
+    #[inline(always)]
+    fn fragment(&self, n: &Vec3) -> Vec3 {
+        // Normalise after interpolation (interpolated unit vectors are shorter than 1):
+        // l = max(n·L / |n|, 0). Written out so `fragment8` can repeat it bit for bit.
+        let len = (n.x * n.x + n.y * n.y + n.z * n.z).sqrt();
+        let d = n.x * self.light.x + n.y * self.light.y + n.z * self.light.z;
+        let l = d / len;
+        let l = if l > 0.0 { l } else { 0.0 };
+        let k = self.ambient + (1.0 - self.ambient) * l;
+        self.base * k
+    }
+
+    #[inline(always)]
+    fn fragment8(&self, var: &[Vec3; 3], w: &[f32x8; 3], _mask: u8) -> [Vec3; 8] {
+        // `Varying::weighted` lane by lane: a + (b − a)·w1 + (c − a)·w2.
+        let c = |f: fn(&Vec3) -> f32| {
+            let (a, b, c) = (f(&var[0]), f(&var[1]), f(&var[2]));
+            f32x8::splat(a) + f32x8::splat(b - a) * w[1] + f32x8::splat(c - a) * w[2]
+        };
+        let (x, y, z) = (c(|v| v.x), c(|v| v.y), c(|v| v.z));
+        let len = (x * x + y * y + z * z).sqrt();
+        let lt = self.light;
+        let d = x * f32x8::splat(lt.x) + y * f32x8::splat(lt.y) + z * f32x8::splat(lt.z);
+        let l = d / len;
+        // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
+        let l = l.simd_gt(f32x8::ZERO).select(l, f32x8::ZERO);
+        let a = f32x8::splat(self.ambient);
+        let k = (a + (f32x8::splat(1.0) - a) * l).to_array();
+        k.map(|k| self.base * k)
+    }
+}
+
+/// Interpolates one attribute per vertex given by a closure and shows it as colour;
+/// used by tests to check interpolation against analytic references.
+pub struct Attribute<F> {
+    pub mvp: Mat4,
+    pub positions: Vec<Vec3>,
+    pub attr: F,
+}
+
+impl<F: Fn(u32) -> Vec3> Shader for Attribute<F> {
+    type Varying = Vec3;
+
+    fn vertex(&self, index: u32) -> (Vec4, Vec3) {
+        let p = self
+            .positions
+            .get(index as usize)
+            .copied()
+            .unwrap_or(Vec3::ZERO);
+        (self.mvp * p.extend(1.0), (self.attr)(index))
+    }
+
+    fn fragment(&self, v: &Vec3) -> Vec3 {
+        *v
+    }
+}

@@ -1,0 +1,82 @@
+//! The standard scene: one model, centred and scaled to max |coordinate| = 1, camera at
+//! distance 2.6 on +z, 45°, near 0.1, far 10, turning about y, per-pixel Lambert
+//! shading with the light towards (0.4, 0.6, 1.0). The benchmark, `render --out` and
+//! the tests all draw it through this one function.
+
+use glam::{Mat4, Vec3};
+
+use super::shaders::Lambert;
+use super::{ColorTarget, DrawOptions, Renderer, VertexCache, transform};
+use crate::camera::Camera;
+use crate::mesh::Mesh;
+use crate::raster::Target;
+
+/// Rotation per frame of the benchmark, radians about y.
+pub const RADIANS_PER_FRAME: f32 = 0.05;
+
+/// Background colour (black).
+pub const BACKGROUND: Vec3 = Vec3::ZERO;
+
+/// Where the standard scene is seen from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StandardView {
+    pub camera: Camera,
+    /// Rotation of the model about y, radians.
+    pub angle: f32,
+    /// Pixel width over pixel height (1 for images, about 0.5 for terminal cells).
+    pub pixel_aspect: f32,
+}
+
+impl StandardView {
+    /// The standard camera, model turned by `angle`, square pixels.
+    #[must_use]
+    pub fn at(angle: f32) -> Self {
+        Self {
+            camera: Camera::default(),
+            angle,
+            pixel_aspect: 1.0,
+        }
+    }
+}
+
+/// Reusable buffers for drawing the standard scene.
+#[derive(Debug)]
+pub struct StandardFrame {
+    pub renderer: Renderer,
+    pub cache: VertexCache<Vec3>,
+}
+
+impl StandardFrame {
+    /// Buffers for a target.
+    #[must_use]
+    pub fn new(target: Target) -> Self {
+        Self {
+            renderer: Renderer::new(target),
+            cache: VertexCache::default(),
+        }
+    }
+
+    /// The shader for the model as seen from `view`.
+    #[must_use]
+    pub fn shader<'m>(mesh: &'m Mesh, view: &StandardView, target: Target) -> Lambert<'m> {
+        let c = &view.camera;
+        let view_proj = c.projection(target.width, target.height, view.pixel_aspect) * c.view();
+        Lambert::new(mesh, Mat4::from_rotation_y(view.angle), view_proj)
+    }
+
+    /// Clears and draws one frame. `mesh` must have normals.
+    pub fn draw<C: ColorTarget>(
+        &mut self,
+        mesh: &Mesh,
+        view: &StandardView,
+        target: Target,
+        opts: &DrawOptions,
+        color: &mut C,
+    ) {
+        let shader = Self::shader(mesh, view, target);
+        self.renderer.begin_frame(target, color, BACKGROUND);
+        transform(&shader, mesh.positions.len(), &mut self.cache);
+        self.renderer
+            .draw(&shader, &self.cache, &mesh.indices, opts, color);
+    }
+}

@@ -1,0 +1,460 @@
+//! The 3D pipeline: perspective-correct interpolation, depth, near-plane clipping,
+//! the probe against the framebuffer, and a snapshot.
+
+use glam::{Mat4, Vec3, Vec4};
+use termrast::camera::Camera;
+use termrast::mesh::Mesh;
+use termrast::raster::Target;
+use termrast::raster::depth::DEPTH_CLEAR;
+use termrast::raster::interp::{Interpolation, Varying};
+use termrast::raster::probe::{DepthOutcome, probe};
+use termrast::render::standard::{StandardFrame, StandardView};
+use termrast::render::target::{luminance, to_u8};
+use termrast::render::{
+    ColorTarget, Cull, DrawOptions, Renderer, Rgba8, Shader, VertexCache, transform,
+};
+
+/// A colour target that keeps exact f32 colours.
+#[derive(Default)]
+struct Exact(Vec<Option<Vec3>>);
+
+impl ColorTarget for Exact {
+    fn put(&mut self, i: usize, c: Vec3) {
+        self.0[i] = Some(c);
+    }
+    fn reset(&mut self, len: usize, _: Vec3) {
+        self.0.clear();
+        self.0.resize(len, None);
+    }
+}
+
+/// Clip-space vertices given directly, with a Vec3 attribute each.
+struct Direct {
+    clip: Vec<Vec4>,
+    attr: Vec<Vec3>,
+}
+
+impl Shader for Direct {
+    type Varying = Vec3;
+    fn vertex(&self, i: u32) -> (Vec4, Vec3) {
+        (self.clip[i as usize], self.attr[i as usize])
+    }
+    fn fragment(&self, v: &Vec3) -> Vec3 {
+        *v
+    }
+}
+
+fn draw(shader: &Direct, indices: &[u32], target: Target, opts: &DrawOptions) -> (Exact, Renderer) {
+    let mut r = Renderer::new(target);
+    let mut out = Exact::default();
+    let mut cache = VertexCache::default();
+    r.begin_frame(target, &mut out, Vec3::ZERO);
+    transform(shader, shader.clip.len(), &mut cache);
+    r.draw(shader, &cache, indices, opts, &mut out);
+    (out, r)
+}
+
+/// A quad tilted in depth whose attribute is its texture coordinate (u across, v along
+/// the slope), checked against the analytic ray–plane intersection in f64.
+///
+/// Error budget: snapping moves a vertex by at most 1/512 px, which shifts an attribute
+/// by its screen gradient / 512; the quad is tilted (not grazing) so that stays below
+/// 1e-4 and the remaining error is f32 rounding.
+#[test]
+fn perspective_correct_matches_ray_plane_reference() {
+    let target = Target::new(256, 192);
+    let camera = Camera::default();
+    let vp = camera.projection(target.width, target.height, 1.0) * camera.view();
+    // A slope rising from y = −1 at z = 1 (near the eye) to y = 1 at z = −2.
+    let world = [
+        Vec3::new(-1.5, -1.0, 1.0),
+        Vec3::new(1.5, -1.0, 1.0),
+        Vec3::new(1.5, 1.0, -2.0),
+        Vec3::new(-1.5, 1.0, -2.0),
+    ];
+    let uv = |p: glam::DVec3| glam::DVec3::new((p.x + 1.5) / 3.0, (1.0 - p.z) / 3.0, 0.0);
+    let [a, b, _, d] = world.map(Vec3::as_dvec3);
+    let normal = (b - a).cross(d - a);
+    let shader = Direct {
+        clip: world.iter().map(|p| vp * p.extend(1.0)).collect(),
+        attr: world.iter().map(|p| uv(p.as_dvec3()).as_vec3()).collect(),
+    };
+    let inv_vp = vp.as_dmat4().inverse();
+    let mut errors = [0f32; 2];
+    for (k, mode) in [Interpolation::Perspective, Interpolation::Affine]
+        .into_iter()
+        .enumerate()
+    {
+        let opts = DrawOptions {
+            interpolation: mode,
+            ..DrawOptions::default()
+        };
+        let (img, _) = draw(&shader, &[0, 1, 2, 0, 2, 3], target, &opts);
+        let mut n = 0;
+        for y in 0..target.height {
+            for x in 0..target.width {
+                let Some(got) = img.0[(y * target.width + x) as usize] else {
+                    continue;
+                };
+                // Ray through the pixel centre, intersected with y = −0.5 in f64.
+                let ndc_x = (f64::from(x) + 0.5) / f64::from(target.width) * 2.0 - 1.0;
+                let ndc_y = 1.0 - (f64::from(y) + 0.5) / f64::from(target.height) * 2.0;
+                let far = inv_vp * glam::DVec4::new(ndc_x, ndc_y, 1.0, 1.0);
+                let far = (far / far.w).truncate();
+                let eye = camera.eye.as_dvec3();
+                let t = normal.dot(a - eye) / normal.dot(far - eye);
+                let want = uv(eye + (far - eye) * t);
+                let err = (got.as_dvec3() - want).abs().max_element() as f32;
+                errors[k] = errors[k].max(err);
+                n += 1;
+            }
+        }
+        assert!(n > 1000, "quad covers the view");
+    }
+    assert!(errors[0] < 1e-4, "perspective error {}", errors[0]);
+    assert!(
+        errors[1] > 0.01,
+        "affine should be visibly wrong, error {}",
+        errors[1]
+    );
+}
+
+#[test]
+fn interpolation_properties() {
+    let target = Target::new(400, 300);
+    // A small triangle far from the origin of a large target, tilted in depth.
+    let clip = vec![
+        Vec4::new(0.5, 0.5, 0.3, 1.0),
+        Vec4::new(1.9, 1.2, 0.8, 2.0),
+        Vec4::new(0.3, 0.475, 0.2, 0.5),
+    ];
+    let attr = vec![
+        Vec3::new(1.0, 5.0, -2.0),
+        Vec3::new(3.0, 5.0, 7.0),
+        Vec3::new(-4.0, 5.0, 0.5),
+    ];
+    let shader = Direct {
+        clip,
+        attr: attr.clone(),
+    };
+    let (img, r) = draw(&shader, &[0, 1, 2], target, &DrawOptions::default());
+    let lo = attr.iter().fold(Vec3::INFINITY, |m, a| m.min(*a));
+    let hi = attr.iter().fold(Vec3::NEG_INFINITY, |m, a| m.max(*a));
+    let mut n = 0;
+    for c in img.0.iter().flatten() {
+        assert_eq!(c.y, 5.0, "a constant attribute stays exactly constant");
+        let tol = Vec3::splat(1e-5) * (hi - lo).abs().max(Vec3::ONE);
+        assert!(
+            c.cmpge(lo - tol).all() && c.cmple(hi + tol).all(),
+            "{c} outside {lo}..{hi}"
+        );
+        n += 1;
+    }
+    assert!(n > 50 && r.stats.shaded == n);
+    // At a vertex, weights are exactly (1, 0, 0): the value is the vertex's own.
+    let v = Vec3::weighted(&attr[0], &attr[1], &attr[2], [1.0, 0.0, 0.0]);
+    assert_eq!(v, attr[0]);
+}
+
+#[test]
+fn close_planes_sort_when_the_gap_is_resolvable() {
+    let target = Target::new(16, 16);
+    let camera = Camera::default();
+    let proj = camera.projection(16, 16, 1.0);
+    let quad = |d: f32| -> Vec<Vec4> {
+        [[-5.0, -5.0], [5.0, -5.0], [5.0, 5.0], [-5.0, 5.0]]
+            .iter()
+            .map(|p| proj * Vec4::new(p[0] * d, p[1] * d, -d, 1.0))
+            .collect()
+    };
+    let ndc = |d: f32| {
+        let c = proj * Vec4::new(0.0, 0.0, -d, 1.0);
+        c.z / c.w
+    };
+    let mut checked = 0;
+    for depth in [0.2f32, 0.5, 1.0, 2.0, 5.0, 9.0] {
+        for gap in [1e-1f32, 1e-2, 1e-3, 1e-4, 1e-5] {
+            let (near, far) = (depth, depth + gap);
+            // Resolvable: the planes land more than 2 f32 steps apart in depth.
+            let (zn, zf) = (ndc(near), ndc(far));
+            let resolvable =
+                zf - zn > 2.0 * (zf.to_bits() as f32 - zf.to_bits() as f32 + f32::EPSILON * zf);
+            if !resolvable {
+                continue;
+            }
+            for order in [[near, far], [far, near]] {
+                let mut clip = quad(order[0]);
+                clip.extend(quad(order[1]));
+                let attr = [Vec3::X; 4].into_iter().chain([Vec3::Y; 4]).collect();
+                let near_colour = if order[0] == near { Vec3::X } else { Vec3::Y };
+                let shader = Direct { clip, attr };
+                let (img, _) = draw(
+                    &shader,
+                    &[0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7],
+                    target,
+                    &DrawOptions::default(),
+                );
+                assert!(
+                    img.0.iter().all(|c| *c == Some(near_colour)),
+                    "depth {depth} gap {gap}"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(
+        checked >= 30,
+        "most cases are resolvable in f32 ({checked})"
+    );
+}
+
+#[test]
+fn interpenetrating_triangles_split_along_their_intersection() {
+    // Two triangles crossing at view depth z = −2: the left half of one is in front.
+    let target = Target::new(64, 64);
+    let camera = Camera::default();
+    let vp = camera.projection(64, 64, 1.0) * camera.view();
+    let a = [
+        Vec3::new(-1.0, -1.0, 0.5),
+        Vec3::new(1.0, -1.0, -0.5),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    let b = [
+        Vec3::new(-1.0, -1.0, -0.5),
+        Vec3::new(1.0, -1.0, 0.5),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    let clip = a.iter().chain(&b).map(|p| vp * p.extend(1.0)).collect();
+    let attr = vec![Vec3::X, Vec3::X, Vec3::X, Vec3::Y, Vec3::Y, Vec3::Y];
+    let (img, _) = draw(
+        &Direct { clip, attr },
+        &[0, 1, 2, 3, 4, 5],
+        target,
+        &DrawOptions::default(),
+    );
+    let mut seen = [0; 2];
+    for y in 0..64 {
+        for x in 0..64 {
+            let Some(c) = img.0[y * 64 + x] else { continue };
+            // World x of the pixel centre on either triangle has the same sign as the
+            // screen x offset from the centre line; a is nearer where x < 0.
+            let sx = x as f32 + 0.5 - 32.0;
+            if sx.abs() < 1.0 {
+                continue;
+            }
+            let want = if sx < 0.0 { Vec3::X } else { Vec3::Y };
+            assert_eq!(c, want, "pixel ({x},{y})");
+            seen[usize::from(sx > 0.0)] += 1;
+        }
+    }
+    assert!(seen[0] > 100 && seen[1] > 100);
+}
+
+#[test]
+fn near_plane_straddling_renders_exactly_the_front_part() {
+    // Clip space chosen so the near-plane crossings are at t = 1/2 exactly (z goes
+    // from −1 to 1 along the cut edges): clipping is exact in f32, and the result
+    // must equal drawing the hand-clipped quad.
+    let target = Target::new(64, 48);
+    let a = Vec4::new(-0.5, -0.5, 0.5, 1.0);
+    let b = Vec4::new(0.6, -0.4, 0.5, 1.0);
+    let c = Vec4::new(0.1, 0.7, -0.5, 1.0); // z < 0: in front of the eye but before near
+    let attr = vec![Vec3::X, Vec3::Y, Vec3::Z];
+    let (img, r) = draw(
+        &Direct {
+            clip: vec![a, b, c],
+            attr: attr.clone(),
+        },
+        &[0, 1, 2],
+        target,
+        &DrawOptions::default(),
+    );
+    assert_eq!(r.stats.clipped, 1);
+    let mid = |p: Vec4, q: Vec4| (p + q) * 0.5;
+    let quad = vec![a, b, mid(b, c), mid(a, c)];
+    let qattr = vec![
+        Vec3::X,
+        Vec3::Y,
+        (Vec3::Y + Vec3::Z) * 0.5,
+        (Vec3::X + Vec3::Z) * 0.5,
+    ];
+    let (want, _) = draw(
+        &Direct {
+            clip: quad,
+            attr: qattr,
+        },
+        &[0, 1, 2, 0, 2, 3],
+        target,
+        &DrawOptions::default(),
+    );
+    let covered = |e: &Exact| e.0.iter().map(Option::is_some).collect::<Vec<_>>();
+    assert_eq!(covered(&img), covered(&want));
+    for (g, w) in img.0.iter().zip(&want.0) {
+        if let (Some(g), Some(w)) = (g, w) {
+            assert!((*g - *w).abs().max_element() < 1e-5);
+        }
+    }
+}
+
+#[test]
+fn vertices_behind_or_at_the_eye_never_leak() {
+    let target = Target::new(48, 32);
+    let front = Vec4::new(0.0, 0.5, 0.5, 1.0);
+    let cases = [
+        ("w < 0", Vec4::new(0.3, -0.4, -0.8, -0.5)),
+        ("w = 0", Vec4::new(0.3, -0.4, 0.0, 0.0)),
+        ("w = 1e-30", Vec4::new(0.3, -0.4, 1e-31, 1e-30)),
+        ("w = -0", Vec4::new(0.3, -0.4, -0.0, -0.0)),
+        ("nan", Vec4::new(f32::NAN, 0.0, 0.5, 1.0)),
+        ("inf", Vec4::new(f32::INFINITY, 0.0, 0.5, 1.0)),
+    ];
+    for (name, bad) in cases {
+        for (i0, i1) in [(0, 1), (1, 0)] {
+            let clip = vec![front, Vec4::new(-0.6, -0.6, 0.5, 1.0), bad];
+            let mut idx = [0u32, 1, 2];
+            idx.swap(i0, i1);
+            let (img, r) = draw(
+                &Direct {
+                    clip,
+                    attr: vec![Vec3::ONE; 3],
+                },
+                &idx,
+                target,
+                &DrawOptions::default(),
+            );
+            for (i, c) in img.0.iter().enumerate() {
+                if c.is_some() {
+                    let d = r.depth.data[i];
+                    assert!(
+                        d.is_finite() && (0.0..=1.0).contains(&d),
+                        "{name}: depth {d}"
+                    );
+                }
+            }
+        }
+        // Entirely behind the eye: nothing at all.
+        let clip = vec![
+            Vec4::new(0.0, 0.0, -1.0, -1.0),
+            Vec4::new(0.5, 0.0, -1.0, -1.0),
+            bad,
+        ];
+        let (img, r) = draw(
+            &Direct {
+                clip,
+                attr: vec![Vec3::ONE; 3],
+            },
+            &[0, 1, 2],
+            target,
+            &DrawOptions::default(),
+        );
+        assert!(img.0.iter().all(Option::is_none), "{name}");
+        assert_eq!(r.stats.rejected, 1);
+    }
+}
+
+fn bunny() -> Mesh {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/bunny.obj");
+    let mut m = Mesh::from_spec(path).expect("bunny loads");
+    m.ensure_normals();
+    m
+}
+
+#[test]
+fn probe_equals_the_framebuffer_for_every_pixel() {
+    let mesh = bunny();
+    assert_eq!(mesh.triangle_count(), 3674);
+    let target = Target::new(120, 90);
+    let camera = Camera::default();
+    for (angle, cull) in [(0.7f32, Cull::None), (2.1, Cull::Back)] {
+        let opts = DrawOptions {
+            cull,
+            ..DrawOptions::default()
+        };
+        let mut frame = StandardFrame::new(target);
+        let mut color = Rgba8::default();
+        let view = StandardView::at(angle);
+        frame.draw(&mesh, &view, target, &opts, &mut color);
+        let shader = StandardFrame::shader(&mesh, &view, target);
+        let mut winners = 0;
+        for y in 0..target.height {
+            for x in 0..target.width {
+                let p = probe(&frame.cache, &mesh.indices, target, &opts, x, y);
+                let i = (y * target.width + x) as usize;
+                assert_eq!(
+                    p.final_depth.to_bits(),
+                    frame.renderer.depth.data[i].to_bits(),
+                    "depth at ({x},{y})"
+                );
+                match p.winner {
+                    Some(w) => {
+                        let rec = &p.records[w];
+                        assert!(rec.eval.covered);
+                        assert!(matches!(rec.depth, DepthOutcome::Passed { .. }));
+                        let c = shader.fragment(&rec.varying);
+                        assert_eq!(
+                            color.0[i],
+                            [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255],
+                            "colour at ({x},{y})"
+                        );
+                        // The winner is the last passing record, and nothing after it passed.
+                        assert!(
+                            p.records[w + 1..]
+                                .iter()
+                                .all(|r| !matches!(r.depth, DepthOutcome::Passed { .. }))
+                        );
+                        winners += 1;
+                    }
+                    None => {
+                        assert_eq!(color.0[i], [0, 0, 0, 255]);
+                        assert_eq!(p.final_depth, DEPTH_CLEAR);
+                    }
+                }
+            }
+        }
+        assert!(winners > 2000, "the bunny covers the frame ({winners})");
+    }
+}
+
+#[test]
+fn teapot_luminance_snapshot() {
+    let mut mesh = Mesh::teapot();
+    mesh.ensure_normals();
+    let target = Target::new(64, 32);
+    let mut frame = StandardFrame::new(target);
+    let mut luma = termrast::render::Luma::default();
+    // Pixels twice as tall as wide, like terminal cells.
+    let view = StandardView {
+        pixel_aspect: 0.5,
+        ..StandardView::at(0.6)
+    };
+    frame.draw(&mesh, &view, target, &DrawOptions::default(), &mut luma);
+    let ramp = b" .:-=+*#%@";
+    let mut text = String::new();
+    for row in luma.0.chunks(64) {
+        for &l in row {
+            text.push(ramp[((l * 9.0).round() as usize).min(9)] as char);
+        }
+        text.push('\n');
+    }
+    insta::assert_snapshot!(text);
+    let _ = luminance(Vec3::ONE);
+}
+
+#[test]
+fn transform_and_cull_counts() {
+    let mesh = bunny();
+    let target = Target::new(160, 120);
+    let mut frame = StandardFrame::new(target);
+    let mut color = Rgba8::default();
+    let opts = DrawOptions {
+        cull: Cull::Back,
+        ..DrawOptions::default()
+    };
+    frame.draw(&mesh, &StandardView::at(0.0), target, &opts, &mut color);
+    let s = frame.renderer.stats;
+    assert_eq!(s.triangles, 3674);
+    assert_eq!(s.drawn + s.culled + s.rejected, s.triangles);
+    // A closed mesh shows roughly half its faces.
+    assert!(s.culled > 1200 && s.drawn > 1200, "{s:?}");
+    let _ = Mat4::IDENTITY;
+}

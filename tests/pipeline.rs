@@ -364,7 +364,6 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
     let mesh = bunny();
     assert_eq!(mesh.triangle_count(), 3674);
     let target = Target::new(120, 90);
-    let camera = Camera::default();
     for (angle, cull) in [(0.7f32, Cull::None), (2.1, Cull::Back)] {
         let opts = DrawOptions {
             cull,

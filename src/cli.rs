@@ -83,11 +83,7 @@ pub fn main() -> ExitCode {
         Some(Command::Render(args)) => render_cmd::png(&args),
         Some(Command::Bench(BenchCommand::Render(args))) => render_cmd::bench_render(&args)
             .and_then(|r| writeln!(io::stdout(), "{r}").map_err(Into::into)),
-        None => {
-            use clap::CommandFactory;
-            let _ = Cli::command().print_help();
-            Ok(())
-        }
+        None => preview(&mut io::stdout().lock()).map_err(Into::into),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -96,4 +92,34 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Luminance ramp of the text preview, darkest first.
+const RAMP: &[u8] = b" .:-=+*#%@";
+
+/// Without a subcommand: one 80×24 text frame of the embedded teapot (cells are about
+/// twice as tall as wide), followed by the list of commands.
+pub fn preview(out: &mut impl Write) -> io::Result<()> {
+    use crate::mesh::Mesh;
+    use crate::render::standard::{StandardFrame, StandardView};
+    use crate::render::{DrawOptions, Luma};
+    let mut mesh = Mesh::teapot();
+    mesh.ensure_normals();
+    let target = Target::new(80, 24);
+    let mut frame = StandardFrame::new(target);
+    let mut luma = Luma::default();
+    let view = StandardView {
+        pixel_aspect: 0.5,
+        ..StandardView::at(0.6)
+    };
+    frame.draw(&mesh, &view, target, &DrawOptions::default(), &mut luma);
+    for row in luma.0.chunks(80) {
+        let line: String = row
+            .iter()
+            .map(|&l| RAMP[((l * 9.0).round() as usize).min(9)] as char)
+            .collect();
+        writeln!(out, "{}", line.trim_end())?;
+    }
+    use clap::CommandFactory;
+    writeln!(out, "{}", Cli::command().render_help())
 }

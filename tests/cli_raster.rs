@@ -93,3 +93,20 @@ fn bad_arguments_are_explained() {
     let (ok, _, err) = raster(&["--traversal", "fast"], "");
     assert!(!ok && err.contains("scalar"), "{err}");
 }
+
+#[test]
+fn no_subcommand_prints_a_teapot_frame_and_the_commands() {
+    let out = Command::new(env!("CARGO_BIN_EXE_termrast"))
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let frame: Vec<&str> = text.lines().take(24).collect();
+    assert!(frame.iter().all(|l| l.len() <= 80));
+    let lit = frame
+        .iter()
+        .map(|l| l.matches(['@', '%', '#']).count())
+        .sum::<usize>();
+    assert!(lit > 100, "the teapot is drawn:\n{}", frame.join("\n"));
+    assert!(text.contains("Usage: termrast") && text.contains("raster") && text.contains("bench"));
+}

@@ -32,22 +32,24 @@ pub trait Shader {
     /// Colour of a fragment.
     fn fragment(&self, v: &Self::Varying) -> Vec3;
 
-    /// Colours of up to 8 fragments of one triangle at once: lane `k` (for each set
-    /// bit of `mask`) has weights `w[..][k]` for the vertex varyings `var`. The default
-    /// interpolates and shades lane by lane; shaders override it with `f32x8` code that
-    /// must give the same bits as [`Shader::fragment`] (the probe relies on it).
+    /// Colours of up to 8 fragments of one triangle at once, as red, green and blue
+    /// lanes: lane `k` (for each set bit of `mask`) has weights `w[..][k]` for the vertex
+    /// varyings `var`. The default interpolates and shades lane by lane; shaders
+    /// override it with `f32x8` code that must give the same bits as
+    /// [`Shader::fragment`] (the probe relies on it).
     #[inline(always)]
-    fn fragment8(&self, var: &[Self::Varying; 3], w: &[f32x8; 3], mask: u8) -> [Vec3; 8] {
+    fn fragment8(&self, var: &[Self::Varying; 3], w: &[f32x8; 3], mask: u8) -> [f32x8; 3] {
         let w = w.map(f32x8::to_array);
-        let mut out = [Vec3::ZERO; 8];
+        let mut out = [[0f32; 8]; 3];
         let mut m = mask;
         while m != 0 {
             let k = m.trailing_zeros() as usize;
             let v = Self::Varying::weighted(&var[0], &var[1], &var[2], [w[0][k], w[1][k], w[2][k]]);
-            out[k] = self.fragment(&v);
+            let c = self.fragment(&v);
+            (out[0][k], out[1][k], out[2][k]) = (c.x, c.y, c.z);
             m &= m - 1;
         }
-        out
+        out.map(f32x8::new)
     }
 }
 
@@ -360,23 +362,22 @@ impl<S: Shader, C: ColorTarget> CoverageSink for Fragments<'_, S, C> {
             .try_into()
             .expect("8 lanes");
         let old = f32x8::new(*slot);
-        let pass = match self.opts.depth.func {
-            DepthFunc::Less => depth.simd_lt(old).to_bitmask() as u8,
-            DepthFunc::LessEqual => depth.simd_le(old).to_bitmask() as u8,
-            DepthFunc::Always => 0xFF,
-        } & mask;
+        let covered = f32x8::new(std::array::from_fn(|k| {
+            f32::from_bits(0u32.wrapping_sub(u32::from(mask >> k & 1)))
+        }));
+        let passing = covered
+            & match self.opts.depth.func {
+                DepthFunc::Less => depth.simd_lt(old),
+                DepthFunc::LessEqual => depth.simd_le(old),
+                DepthFunc::Always => covered,
+            };
+        let pass = passing.to_bitmask() as u8;
         self.fragments += u64::from(mask.count_ones());
         if pass == 0 {
             return;
         }
         if self.opts.depth.write {
-            let lanes = depth.to_array();
-            let mut m = pass;
-            while m != 0 {
-                let k = m.trailing_zeros() as usize;
-                slot[k] = lanes[k];
-                m &= m - 1;
-            }
+            *slot = passing.select(depth, old).to_array();
         }
         let w = match self.opts.interpolation {
             Interpolation::Perspective => {

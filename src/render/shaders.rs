@@ -66,13 +66,13 @@ impl Shader for Lambert<'_> {
     }
 
     #[inline(always)]
-    fn fragment8(&self, var: &[Vec3; 3], w: &[f32x8; 3], _mask: u8) -> [Vec3; 8] {
+    fn fragment8(&self, var: &[Vec3; 3], w: &[f32x8; 3], _mask: u8) -> [f32x8; 3] {
         // `Varying::weighted` lane by lane: a + (b − a)·w1 + (c − a)·w2.
-        let c = |f: fn(&Vec3) -> f32| {
-            let (a, b, c) = (f(&var[0]), f(&var[1]), f(&var[2]));
+        let c = |a: f32, b: f32, c: f32| {
             f32x8::splat(a) + f32x8::splat(b - a) * w[1] + f32x8::splat(c - a) * w[2]
         };
-        let (x, y, z) = (c(|v| v.x), c(|v| v.y), c(|v| v.z));
+        let [p, q, r] = var;
+        let (x, y, z) = (c(p.x, q.x, r.x), c(p.y, q.y, r.y), c(p.z, q.z, r.z));
         let len = (x * x + y * y + z * z).sqrt();
         let lt = self.light;
         let d = x * f32x8::splat(lt.x) + y * f32x8::splat(lt.y) + z * f32x8::splat(lt.z);
@@ -80,8 +80,8 @@ impl Shader for Lambert<'_> {
         // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
         let l = l.simd_gt(f32x8::ZERO).select(l, f32x8::ZERO);
         let a = f32x8::splat(self.ambient);
-        let k = (a + (f32x8::splat(1.0) - a) * l).to_array();
-        k.map(|k| self.base * k)
+        let k = a + (f32x8::splat(1.0) - a) * l;
+        [self.base.x, self.base.y, self.base.z].map(|c| f32x8::splat(c) * k)
     }
 }
 

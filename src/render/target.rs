@@ -1,6 +1,7 @@
 //! Colour targets: what fragments are written into.
 
 use glam::Vec3;
+use wide::{f32x8, i32x8};
 
 /// A framebuffer a draw writes shaded fragments into. Generic so the write is
 /// inlined into the fragment loop.
@@ -10,13 +11,15 @@ pub trait ColorTarget {
     /// Fills the whole target, resizing to `len` pixels only if needed.
     fn reset(&mut self, len: usize, c: Vec3);
 
-    /// Writes `c[k]` to pixel `start + k` for each set bit `k` of `mask`.
+    /// Writes colour lane `k` (red, green, blue lanes) to pixel `start + k` for each
+    /// set bit `k` of `mask`; must store what [`ColorTarget::put`] would.
     #[inline(always)]
-    fn put8(&mut self, start: usize, mask: u8, c: &[Vec3; 8]) {
+    fn put8(&mut self, start: usize, mask: u8, c: &[f32x8; 3]) {
+        let c = c.map(f32x8::to_array);
         let mut m = mask;
         while m != 0 {
             let k = m.trailing_zeros() as usize;
-            self.put(start + k, c[k]);
+            self.put(start + k, Vec3::new(c[0][k], c[1][k], c[2][k]));
             m &= m - 1;
         }
     }
@@ -33,10 +36,31 @@ pub fn to_u8(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
 
+/// [`to_u8`] on 8 lanes, bit for bit (NaN gives 0 in both).
+#[must_use]
+#[inline(always)]
+pub fn to_u8x8(v: f32x8) -> i32x8 {
+    let zero = f32x8::ZERO;
+    let v = v.simd_gt(zero).select(v, zero);
+    let v = v.simd_lt(f32x8::ONE).select(v, f32x8::ONE);
+    (v * f32x8::splat(255.0) + f32x8::splat(0.5)).trunc_int()
+}
+
 impl ColorTarget for Rgba8 {
     #[inline(always)]
     fn put(&mut self, index: usize, c: Vec3) {
         self.0[index] = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255];
+    }
+    #[inline(always)]
+    fn put8(&mut self, start: usize, mask: u8, c: &[f32x8; 3]) {
+        // Pack to little-endian RGBA words and blend all 8 pixels in one store.
+        let [r, g, b] = c.map(to_u8x8);
+        let px = r | (g << 8) | (b << 16) | i32x8::splat(0xFF << 24);
+        let dst: &mut [i32; 8] = bytemuck::cast_slice_mut(&mut self.0[start..start + 8])
+            .try_into()
+            .expect("8 pixels");
+        let lanes = i32x8::new(std::array::from_fn(|k| -i32::from(mask >> k & 1)));
+        *dst = lanes.select(px, i32x8::new(*dst)).to_array();
     }
     fn reset(&mut self, len: usize, c: Vec3) {
         let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255];
@@ -75,7 +99,7 @@ impl<A: ColorTarget, B: ColorTarget> ColorTarget for (A, B) {
         self.1.put(index, c);
     }
     #[inline(always)]
-    fn put8(&mut self, start: usize, mask: u8, c: &[Vec3; 8]) {
+    fn put8(&mut self, start: usize, mask: u8, c: &[f32x8; 3]) {
         self.0.put8(start, mask, c);
         self.1.put8(start, mask, c);
     }

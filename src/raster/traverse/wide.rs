@@ -100,19 +100,21 @@ pub fn wide<S: CoverageSink>(s: &Setup, sink: &mut S) {
     }
 }
 
-/// The pixels of one row that can pass all three edges: a conservative range (one
-/// pixel of slack on each side of the real-valued crossings), so skipping the rest is
-/// exact; the lanes still test every pixel inside it. `None` when the row is empty.
+/// The pixels of one row that can pass all three edges: a conservative range (at
+/// least one pixel of slack on each side of the real-valued crossings), so skipping
+/// the rest is exact; the lanes still test every pixel inside it. `None` when the row
+/// is empty. Truncation with two pixels of slack stands in for floor/ceil, which are
+/// library calls on baseline x86-64.
 #[inline(always)]
 fn row_range(f: [i64; 3], sx: [i64; 3], x0: u32, x1: u32) -> Option<(u32, u32)> {
-    let (mut lo, mut hi) = (f64::from(x0), f64::from(x1));
+    let (mut lo, mut hi) = (i64::from(x0), i64::from(x1));
     for e in 0..3 {
         let (fe, se) = (f[e] as f64, sx[e] as f64);
         if sx[e] > 0 {
             // F(x) = f + (x − x0)·sx ≥ 0  ⇔  x ≥ x0 − f/sx
-            lo = lo.max(f64::from(x0) + (-fe / se).floor() - 1.0);
+            lo = lo.max(i64::from(x0) + (-fe / se) as i64 - 2);
         } else if sx[e] < 0 {
-            hi = hi.min(f64::from(x0) + (fe / -se).ceil() + 1.0);
+            hi = hi.min(i64::from(x0) + (fe / -se) as i64 + 2);
         } else if f[e] < 0 {
             return None;
         }

@@ -2,6 +2,7 @@
 //!
 //! The binary calls [`main`]; everything here is library code so the tests can drive it.
 
+pub mod line_cmd;
 pub mod raster_cmd;
 pub mod render_cmd;
 
@@ -25,6 +26,8 @@ pub struct Cli {
 pub enum Command {
     /// Rasterize 2D triangles read from stdin (`x0 y0 x1 y1 x2 y2` per line, pixels).
     Raster(raster_cmd::RasterArgs),
+    /// Draw a line with the midpoint (Bresenham) algorithm, optionally traced.
+    Line(line_cmd::LineArgs),
     /// Render one frame of a model to a PNG file.
     Render(render_cmd::PngArgs),
     /// Benchmarks.
@@ -46,6 +49,8 @@ pub enum CliError {
     Raster(#[from] raster_cmd::RasterError),
     #[error(transparent)]
     Mesh(#[from] crate::mesh::MeshError),
+    #[error(transparent)]
+    Line(#[from] line_cmd::LineError),
     #[error("{0}: {1}")]
     Image(std::path::PathBuf, image::ImageError),
     #[error(transparent)]
@@ -81,6 +86,9 @@ pub fn main() -> ExitCode {
             raster_cmd::run(&args, io::stdin().lock(), io::stdout().lock()).map_err(Into::into)
         }
         Some(Command::Render(args)) => render_cmd::png(&args),
+        Some(Command::Line(args)) => {
+            line_cmd::run(&args, &mut io::stdout().lock()).map_err(Into::into)
+        }
         Some(Command::Bench(BenchCommand::Render(args))) => render_cmd::bench_render(&args)
             .and_then(|r| writeln!(io::stdout(), "{r}").map_err(Into::into)),
         None => preview(&mut io::stdout().lock()).map_err(Into::into),

@@ -38,6 +38,7 @@
 pub mod clip;
 pub mod depth;
 pub mod interp;
+pub mod line;
 pub mod oracle;
 pub mod probe;
 pub mod setup;

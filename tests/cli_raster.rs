@@ -110,3 +110,55 @@ fn no_subcommand_prints_a_teapot_frame_and_the_commands() {
     assert!(lit > 100, "the teapot is drawn:\n{}", frame.join("\n"));
     assert!(text.contains("Usage: termrast") && text.contains("raster") && text.contains("bench"));
 }
+
+fn termrast(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_termrast"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+#[test]
+fn line_command_traces_the_seed_example() {
+    let (ok, out, err) = termrast(&["line", "5", "8", "9", "11", "--trace", "--format", "cells"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("dx=4 dy=3 incrE=6 incrNE=-2 d0=2"), "{out}");
+    let rows: Vec<(String, String)> = out
+        .lines()
+        .filter_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            (w.len() == 5 && w[0].parse::<u32>().is_ok())
+                .then(|| (w[2].to_string(), w[3].to_string()))
+        })
+        .collect();
+    let want = [("2", "NE"), ("0", "E"), ("6", "NE"), ("4", "NE")];
+    assert_eq!(rows.len(), 4, "{out}");
+    for (r, w) in rows.iter().zip(want) {
+        assert_eq!((r.0.as_str(), r.1.as_str()), w);
+    }
+    assert!(out.trim_end().ends_with("5,8 6,9 7,9 8,10 9,11"), "{out}");
+    let (_, grid, _) = termrast(&["line", "0", "4", "4", "2"]);
+    assert_eq!(grid, "origin (0,2)\n....#\n..##.\n##...\n");
+}
+
+#[test]
+fn line_command_rejects_bad_input() {
+    let (ok, _, err) = termrast(&["line", "1", "2", "x", "4"]);
+    assert!(!ok && err.contains("invalid value 'x'"), "{err}");
+    let (ok, _, err) = termrast(&["line", "0", "0", "5000", "0"]);
+    assert!(!ok && err.contains("--format cells"), "{err}");
+    let (ok, _, err) = termrast(&["line", "0", "0", "9999999999999", "0", "--format", "cells"]);
+    assert!(!ok && err.contains("2^40"), "{err}");
+    let (ok, out, _) = termrast(&[
+        "line", "-1000000", "-2", "1000000", "3", "--size", "8x4", "--format", "cells",
+    ]);
+    assert!(ok);
+    // At x = 0 the ideal y is exactly 0.5: a tie, resolved toward the start's row (0);
+    // from x = 1 on it is above 0.5.
+    assert_eq!(out, "0,0 1,1 2,1 3,1 4,1 5,1 6,1 7,1\n");
+}

@@ -113,6 +113,7 @@ pub fn preview(out: &mut impl Write) -> io::Result<()> {
     use crate::render::{DrawOptions, Luma};
     let mut mesh = Mesh::teapot();
     mesh.ensure_normals();
+    let model = crate::render::standard::Model::new(mesh);
     let target = Target::new(80, 24);
     let mut frame = StandardFrame::new(target);
     let mut luma = Luma::default();
@@ -120,7 +121,14 @@ pub fn preview(out: &mut impl Write) -> io::Result<()> {
         pixel_aspect: 0.5,
         ..StandardView::at(0.6)
     };
-    frame.draw(&mesh, &view, target, &DrawOptions::default(), &mut luma);
+    frame.draw(
+        &model,
+        &view,
+        target,
+        &DrawOptions::default(),
+        Default::default(),
+        &mut luma,
+    );
     for row in luma.0.chunks(80) {
         let line: String = row
             .iter()

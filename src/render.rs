@@ -12,6 +12,7 @@
 pub mod shaders;
 pub mod standard;
 pub mod target;
+pub mod wire;
 
 use glam::{Vec3, Vec4};
 
@@ -199,7 +200,7 @@ impl<V: Varying> Prepared<V> {
 /// viewer allocates nothing per frame.
 #[derive(Debug)]
 pub struct VertexCache<V> {
-    verts: Vec<ClipVertex<V>>,
+    pub(crate) verts: Vec<ClipVertex<V>>,
 }
 
 impl<V> Default for VertexCache<V> {

@@ -8,8 +8,9 @@ use termrast::raster::Target;
 use termrast::raster::depth::DEPTH_CLEAR;
 use termrast::raster::interp::{Interpolation, Varying};
 use termrast::raster::probe::{DepthOutcome, probe};
-use termrast::render::standard::{StandardFrame, StandardView};
+use termrast::render::standard::{Model, StandardFrame, StandardView};
 use termrast::render::target::{luminance, to_u8};
+use termrast::render::wire::Mode;
 use termrast::render::{
     ColorTarget, Cull, DrawOptions, Renderer, Rgba8, Shader, VertexCache, transform,
 };
@@ -362,6 +363,7 @@ fn bunny() -> Mesh {
 #[test]
 fn probe_equals_the_framebuffer_for_every_pixel() {
     let mesh = bunny();
+    let model = Model::new(mesh.clone());
     assert_eq!(mesh.triangle_count(), 3674);
     let target = Target::new(120, 90);
     for (angle, cull) in [(0.7f32, Cull::None), (2.1, Cull::Back)] {
@@ -372,7 +374,7 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
         let mut frame = StandardFrame::new(target);
         let mut color = Rgba8::default();
         let view = StandardView::at(angle);
-        frame.draw(&mesh, &view, target, &opts, &mut color);
+        frame.draw(&model, &view, target, &opts, Mode::Fill, &mut color);
         let shader = StandardFrame::shader(&mesh, &view, target);
         let mut winners = 0;
         for y in 0..target.height {
@@ -426,7 +428,14 @@ fn teapot_luminance_snapshot() {
         pixel_aspect: 0.5,
         ..StandardView::at(0.6)
     };
-    frame.draw(&mesh, &view, target, &DrawOptions::default(), &mut luma);
+    frame.draw(
+        &Model::new(mesh.clone()),
+        &view,
+        target,
+        &DrawOptions::default(),
+        Mode::Fill,
+        &mut luma,
+    );
     let ramp = b" .:-=+*#%@";
     let mut text = String::new();
     for row in luma.0.chunks(64) {
@@ -449,7 +458,14 @@ fn transform_and_cull_counts() {
         cull: Cull::Back,
         ..DrawOptions::default()
     };
-    frame.draw(&mesh, &StandardView::at(0.0), target, &opts, &mut color);
+    frame.draw(
+        &Model::new(mesh.clone()),
+        &StandardView::at(0.0),
+        target,
+        &opts,
+        Mode::Fill,
+        &mut color,
+    );
     let s = frame.renderer.stats;
     assert_eq!(s.triangles, 3674);
     assert_eq!(s.drawn + s.culled + s.rejected, s.triangles);

@@ -9,7 +9,8 @@ use clap::Args;
 use crate::mesh::Mesh;
 use crate::raster::interp::Interpolation;
 use crate::raster::{Target, Traversal};
-use crate::render::standard::{RADIANS_PER_FRAME, StandardFrame, StandardView};
+use crate::render::standard::{Model, RADIANS_PER_FRAME, StandardFrame, StandardView};
+use crate::render::wire::Mode;
 use crate::render::{Cull, DrawOptions, Rgba8};
 
 /// Options shared by the 3D commands.
@@ -27,6 +28,9 @@ pub struct SceneArgs {
     /// Traversal (all give identical images).
     #[arg(long, value_enum, default_value_t = Traversal::Wide)]
     pub traversal: Traversal,
+    /// Filled triangles, wireframe, or filled with visible edges.
+    #[arg(long, value_enum, default_value_t = Mode::Fill)]
+    pub mode: Mode,
 }
 
 impl SceneArgs {
@@ -39,10 +43,10 @@ impl SceneArgs {
         }
     }
 
-    fn mesh(&self) -> Result<Mesh, crate::mesh::MeshError> {
+    fn model(&self) -> Result<Model, crate::mesh::MeshError> {
         let mut m = Mesh::from_spec(&self.model)?;
         m.ensure_normals();
-        Ok(m)
+        Ok(Model::new(m))
     }
 }
 
@@ -80,15 +84,16 @@ pub struct BenchRenderArgs {
 
 /// Writes one frame of the standard scene as a PNG.
 pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
-    let mesh = args.scene.mesh()?;
+    let model = args.scene.model()?;
     let target = args.size;
     let mut frame = StandardFrame::new(target);
     let mut color = Rgba8::default();
     frame.draw(
-        &mesh,
+        &model,
         &StandardView::at(args.angle),
         target,
         &args.scene.options(),
+        args.scene.mode,
         &mut color,
     );
     let bytes: Vec<u8> = color.0.iter().flatten().copied().collect();
@@ -126,7 +131,7 @@ impl std::fmt::Display for BenchReport {
 
 /// Runs the standard benchmark: clear colour and depth, draw, per frame.
 pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliError> {
-    let mesh = args.scene.mesh()?;
+    let model = args.scene.model()?;
     let target = args.size;
     let opts = args.scene.options();
     let mut frame = StandardFrame::new(target);
@@ -137,10 +142,11 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
     for n in 0..frames {
         let start = Instant::now();
         frame.draw(
-            &mesh,
+            &model,
             &StandardView::at(n as f32 * RADIANS_PER_FRAME),
             target,
             &opts,
+            args.scene.mode,
             &mut color,
         );
         times.push(start.elapsed().as_secs_f64() * 1e3);
@@ -150,7 +156,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
     Ok(BenchReport {
         median_ms: times[times.len() / 2],
         min_ms: times[0],
-        triangles: mesh.triangle_count(),
+        triangles: model.mesh.triangle_count(),
         covered_px: covered / u64::from(frames),
     })
 }

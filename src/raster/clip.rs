@@ -146,3 +146,33 @@ pub fn guard_band_ndc(width: u32, height: u32) -> [f32; 2] {
     let g = super::GUARD_BAND_PX as f32 * 0.5;
     [g / width.max(1) as f32, g / height.max(1) as f32]
 }
+
+/// Clips a segment against the same planes as triangles; `None` if nothing is left.
+/// Returns the clipped endpoints and their parameters along the original segment.
+#[must_use]
+pub fn clip_segment(a: Vec4, b: Vec4, guard: [f32; 2]) -> Option<([Vec4; 2], [f32; 2])> {
+    if !a.is_finite() || !b.is_finite() {
+        return None;
+    }
+    let (da, db) = (distances(a, guard), distances(b, guard));
+    let (mut t0, mut t1) = (0.0f32, 1.0f32);
+    for p in 0..6 {
+        match (da[p] >= 0.0, db[p] >= 0.0) {
+            (true, true) => {}
+            (false, false) => return None,
+            (inside_a, _) => {
+                let t = da[p] / (da[p] - db[p]);
+                if inside_a {
+                    t1 = t1.min(t);
+                } else {
+                    t0 = t0.max(t);
+                }
+            }
+        }
+    }
+    if t0 > t1 {
+        return None;
+    }
+    let (p0, p1) = (a + (b - a) * t0, a + (b - a) * t1);
+    (p0.w > 0.0 && p1.w > 0.0).then_some(([p0, p1], [t0, t1]))
+}

@@ -6,6 +6,7 @@
 use glam::{Mat4, Vec3};
 
 use super::shaders::Lambert;
+use super::wire::{Mode, draw_wireframe, unique_edges};
 use super::{ColorTarget, DrawOptions, Renderer, VertexCache, transform};
 use crate::camera::Camera;
 use crate::mesh::Mesh;
@@ -39,6 +40,25 @@ impl StandardView {
     }
 }
 
+/// A mesh with its unique edges (for wireframes), computed once.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub mesh: Mesh,
+    pub edges: Vec<[u32; 2]>,
+}
+
+impl Model {
+    /// Computes the edges of a mesh.
+    #[must_use]
+    pub fn new(mesh: Mesh) -> Self {
+        let edges = unique_edges(&mesh.indices);
+        Self { mesh, edges }
+    }
+}
+
+/// Colour of wireframe lines.
+pub const WIRE_COLOR: Vec3 = Vec3::new(1.0, 0.75, 0.2);
+
 /// Reusable buffers for drawing the standard scene.
 #[derive(Debug)]
 pub struct StandardFrame {
@@ -64,19 +84,30 @@ impl StandardFrame {
         Lambert::new(mesh, Mat4::from_rotation_y(view.angle), view_proj)
     }
 
-    /// Clears and draws one frame. `mesh` must have normals.
+    /// Clears and draws one frame in `mode`. The mesh must have normals. Returns the
+    /// number of wireframe pixels written.
     pub fn draw<C: ColorTarget>(
         &mut self,
-        mesh: &Mesh,
+        model: &Model,
         view: &StandardView,
         target: Target,
         opts: &DrawOptions,
+        mode: Mode,
         color: &mut C,
-    ) {
+    ) -> u64 {
+        let mesh = &model.mesh;
         let shader = Self::shader(mesh, view, target);
         self.renderer.begin_frame(target, color, BACKGROUND);
         transform(&shader, mesh.positions.len(), &mut self.cache);
-        self.renderer
-            .draw(&shader, &self.cache, &mesh.indices, opts, color);
+        if mode.fills() {
+            self.renderer
+                .draw(&shader, &self.cache, &mesh.indices, opts, color);
+        }
+        if mode.wires() {
+            let depth = mode.fills().then_some(&self.renderer.depth);
+            draw_wireframe(&self.cache, &model.edges, target, depth, WIRE_COLOR, color)
+        } else {
+            0
+        }
     }
 }

@@ -5,6 +5,7 @@
 pub mod line_cmd;
 pub mod raster_cmd;
 pub mod render_cmd;
+pub mod view_cmd;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -14,21 +15,32 @@ use clap::{Parser, Subcommand};
 use crate::raster::Target;
 
 /// Terminal 3D rasterizer with an exact edge-function core.
+///
+/// Without a subcommand it opens the viewer: `termrast [MODEL]` is `termrast view [MODEL]`.
 #[derive(Debug, Parser)]
-#[command(name = "termrast", version, about)]
+#[command(
+    name = "termrast",
+    version,
+    about,
+    args_conflicts_with_subcommands = true
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
+    #[command(flatten)]
+    pub view: view_cmd::ViewArgs,
 }
 
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Spin a model in the terminal, with a per-cell raster inspector (the default).
+    View(view_cmd::ViewArgs),
     /// Rasterize 2D triangles read from stdin (`x0 y0 x1 y1 x2 y2` per line, pixels).
     Raster(raster_cmd::RasterArgs),
     /// Draw a line with the midpoint (Bresenham) algorithm, optionally traced.
     Line(line_cmd::LineArgs),
-    /// Render one frame of a model to a PNG file.
+    /// Render frames as ANSI text to stdout (for pipes and scripts), or a PNG with --out.
     Render(render_cmd::PngArgs),
     /// Benchmarks.
     #[command(subcommand)]
@@ -53,6 +65,8 @@ pub enum CliError {
     Line(#[from] line_cmd::LineError),
     #[error("{0}: {1}")]
     Image(std::path::PathBuf, image::ImageError),
+    #[error(transparent)]
+    View(#[from] crate::tui::ViewError),
     #[error(transparent)]
     Io(#[from] io::Error),
 }
@@ -91,7 +105,8 @@ pub fn main() -> ExitCode {
         }
         Some(Command::Bench(BenchCommand::Render(args))) => render_cmd::bench_render(&args)
             .and_then(|r| writeln!(io::stdout(), "{r}").map_err(Into::into)),
-        None => preview(&mut io::stdout().lock()).map_err(Into::into),
+        Some(Command::View(args)) => view_cmd::view(&args),
+        None => view_cmd::view(&cli.view),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -100,42 +115,4 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
-}
-
-/// Luminance ramp of the text preview, darkest first.
-const RAMP: &[u8] = b" .:-=+*#%@";
-
-/// Without a subcommand: one 80×24 text frame of the embedded teapot (cells are about
-/// twice as tall as wide), followed by the list of commands.
-pub fn preview(out: &mut impl Write) -> io::Result<()> {
-    use crate::mesh::Mesh;
-    use crate::render::standard::{StandardFrame, StandardView};
-    use crate::render::{DrawOptions, Luma};
-    let mut mesh = Mesh::teapot();
-    mesh.ensure_normals();
-    let model = crate::render::standard::Model::new(mesh);
-    let target = Target::new(80, 24);
-    let mut frame = StandardFrame::new(target);
-    let mut luma = Luma::default();
-    let view = StandardView {
-        pixel_aspect: 0.5,
-        ..StandardView::at(0.6)
-    };
-    frame.draw(
-        &model,
-        &view,
-        target,
-        &DrawOptions::default(),
-        Default::default(),
-        &mut luma,
-    );
-    for row in luma.0.chunks(80) {
-        let line: String = row
-            .iter()
-            .map(|&l| RAMP[((l * 9.0).round() as usize).min(9)] as char)
-            .collect();
-        writeln!(out, "{}", line.trim_end())?;
-    }
-    use clap::CommandFactory;
-    writeln!(out, "{}", Cli::command().render_help())
 }

@@ -8,4 +8,6 @@ pub mod cli;
 pub mod mesh;
 pub mod raster;
 pub mod render;
+pub mod terminal;
+pub mod tui;
 pub mod workload;

@@ -95,20 +95,48 @@ fn bad_arguments_are_explained() {
 }
 
 #[test]
-fn no_subcommand_prints_a_teapot_frame_and_the_commands() {
+fn the_viewer_refuses_a_pipe_and_suggests_render() {
     let out = Command::new(env!("CARGO_BIN_EXE_termrast"))
         .output()
         .unwrap();
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
-    let frame: Vec<&str> = text.lines().take(24).collect();
-    assert!(frame.iter().all(|l| l.len() <= 80));
-    let lit = frame
-        .iter()
-        .map(|l| l.matches(['@', '%', '#']).count())
-        .sum::<usize>();
-    assert!(lit > 100, "the teapot is drawn:\n{}", frame.join("\n"));
-    assert!(text.contains("Usage: termrast") && text.contains("raster") && text.contains("bench"));
+    assert!(!out.status.success());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("not a terminal") && err.contains("termrast render"),
+        "{err}"
+    );
+}
+
+#[test]
+fn render_writes_text_frames() {
+    let (ok, out, err) = termrast(&[
+        "render", "--cols", "40", "--rows", "12", "--color", "none", "--frames", "2",
+    ]);
+    assert!(ok, "{err}");
+    let frames: Vec<&str> = out.split("\n\n").collect();
+    assert_eq!(frames.len(), 2, "frames are separated by a blank line");
+    for f in frames {
+        let lines: Vec<&str> = f.trim_end_matches('\n').split('\n').collect();
+        assert_eq!(lines.len(), 12);
+        assert!(lines.iter().all(|l| l.chars().count() == 40));
+        let dots = f
+            .chars()
+            .filter(|c| ('\u{2801}'..='\u{28FF}').contains(c))
+            .count();
+        assert!(dots > 50, "the teapot is drawn in braille:\n{f}");
+    }
+    let (ok, out, _) = termrast(&[
+        "render",
+        "--cols",
+        "20",
+        "--rows",
+        "6",
+        "--color",
+        "truecolor",
+        "--glyphs",
+        "half",
+    ]);
+    assert!(ok && out.contains("\u{1b}[38;2;") && out.contains('▀'));
 }
 
 fn termrast(args: &[&str]) -> (bool, String, String) {

@@ -406,7 +406,7 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
                         winners += 1;
                     }
                     None => {
-                        assert_eq!(color.0[i], [0, 0, 0, 255]);
+                        assert_eq!(color.0[i], [0, 0, 0, 0]);
                         assert_eq!(p.final_depth, DEPTH_CLEAR);
                     }
                 }

@@ -86,7 +86,7 @@ fn hidden_lines_behind_a_face_are_removed() {
     draw_wireframe(&cache, &far_edges, target, None, WIRE_COLOR, &mut all);
     let (mut behind, mut outside) = (0, 0);
     for i in 0..target.len() {
-        let under_near = color.0[i] != [0, 0, 0, 255];
+        let under_near = color.0[i][3] == 255;
         if all.0[i] == wire {
             if under_near {
                 behind += 1;

@@ -1,6 +1,7 @@
 //! `termrast render` (one frame to PNG) and `termrast bench render` (the standard
 //! benchmark scene).
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -50,20 +51,36 @@ impl SceneArgs {
     }
 }
 
-/// Arguments of `termrast render --out`.
+/// Arguments of `termrast render`: ANSI text frames to stdout, or a PNG with `--out`.
 #[derive(Debug, Args)]
 pub struct PngArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Image size in pixels, WxH.
+    /// PNG image size in pixels, WxH (with --out).
     #[arg(long, value_parser = super::parse_size, default_value = "640x480")]
     pub size: Target,
-    /// Rotation about y in radians.
+    /// Rotation about y in radians (of the first frame).
     #[arg(long, default_value_t = 0.6, allow_negative_numbers = true)]
     pub angle: f32,
-    /// PNG file to write.
+    /// Write one frame as a PNG file instead of text.
     #[arg(long)]
-    pub out: PathBuf,
+    pub out: Option<PathBuf>,
+    /// Text frames: number of frames (each turns the model by 0.05 rad).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    pub frames: u32,
+    /// Text frames: columns.
+    #[arg(long, default_value_t = 80, value_parser = clap::value_parser!(u16).range(1..=1000))]
+    pub cols: u16,
+    /// Text frames: rows.
+    #[arg(long, default_value_t = 24, value_parser = clap::value_parser!(u16).range(1..=1000))]
+    pub rows: u16,
+    /// Text frames: start each with cursor-home instead of separating them by a blank
+    /// line, so a terminal shows an animation.
+    #[arg(long)]
+    pub animate: bool,
+    /// Glyphs and colours of text frames.
+    #[command(flatten)]
+    pub look: super::view_cmd::LookArgs,
 }
 
 /// Arguments of `termrast bench render`.
@@ -82,9 +99,28 @@ pub struct BenchRenderArgs {
     pub threads: u32,
 }
 
-/// Writes one frame of the standard scene as a PNG.
+/// Writes frames of the standard scene as ANSI text, or one as a PNG with `--out`.
 pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
     let model = args.scene.model()?;
+    let Some(out_path) = &args.out else {
+        let mut settings = args.look.settings(args.scene.mode, args.scene.cull);
+        settings.angle = args.angle;
+        settings.tilt = 0.0;
+        let mut vp = crate::tui::viewport::Viewport::default();
+        let mut out = std::io::stdout().lock();
+        for n in 0..args.frames {
+            settings.angle = args.angle + n as f32 * RADIANS_PER_FRAME;
+            vp.render(&model, &settings, args.cols, args.rows);
+            if args.animate {
+                out.write_all(b"\x1b[H")?;
+            } else if n > 0 {
+                out.write_all(b"\n")?;
+            }
+            super::view_cmd::write_ansi(&vp, &mut out)?;
+        }
+        out.flush()?;
+        return Ok(());
+    };
     let target = args.size;
     let mut frame = StandardFrame::new(target);
     let mut color = Rgba8::default();
@@ -96,15 +132,20 @@ pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
         args.scene.mode,
         &mut color,
     );
-    let bytes: Vec<u8> = color.0.iter().flatten().copied().collect();
+    // Opaque PNG: the uncovered background (alpha 0 in the target) is black.
+    let bytes: Vec<u8> = color
+        .0
+        .iter()
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
     image::save_buffer(
-        &args.out,
+        out_path,
         &bytes,
         target.width,
         target.height,
         image::ExtendedColorType::Rgba8,
     )
-    .map_err(|e| super::CliError::Image(args.out.clone(), e))?;
+    .map_err(|e| super::CliError::Image(out_path.clone(), e))?;
     Ok(())
 }
 

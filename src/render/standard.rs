@@ -3,6 +3,8 @@
 //! shading with the light towards (0.4, 0.6, 1.0). The benchmark, `render --out` and
 //! the tests all draw it through this one function.
 
+use std::time::Instant;
+
 use glam::{Mat4, Vec3};
 
 use super::shaders::Lambert;
@@ -24,6 +26,8 @@ pub struct StandardView {
     pub camera: Camera,
     /// Rotation of the model about y, radians.
     pub angle: f32,
+    /// Rotation of the model about x (applied after `angle`), radians.
+    pub tilt: f32,
     /// Pixel width over pixel height (1 for images, about 0.5 for terminal cells).
     pub pixel_aspect: f32,
 }
@@ -35,6 +39,7 @@ impl StandardView {
         Self {
             camera: Camera::default(),
             angle,
+            tilt: 0.0,
             pixel_aspect: 1.0,
         }
     }
@@ -64,6 +69,9 @@ pub const WIRE_COLOR: Vec3 = Vec3::new(1.0, 0.75, 0.2);
 pub struct StandardFrame {
     pub renderer: Renderer,
     pub cache: VertexCache<Vec3>,
+    /// Time of the last frame's vertex stage and of its raster stage (coverage, depth
+    /// and shading are one fused loop, so they are timed together).
+    pub timing: [std::time::Duration; 2],
 }
 
 impl StandardFrame {
@@ -73,6 +81,7 @@ impl StandardFrame {
         Self {
             renderer: Renderer::new(target),
             cache: VertexCache::default(),
+            timing: Default::default(),
         }
     }
 
@@ -81,7 +90,8 @@ impl StandardFrame {
     pub fn shader<'m>(mesh: &'m Mesh, view: &StandardView, target: Target) -> Lambert<'m> {
         let c = &view.camera;
         let view_proj = c.projection(target.width, target.height, view.pixel_aspect) * c.view();
-        Lambert::new(mesh, Mat4::from_rotation_y(view.angle), view_proj)
+        let model = Mat4::from_rotation_x(view.tilt) * Mat4::from_rotation_y(view.angle);
+        Lambert::new(mesh, model, view_proj)
     }
 
     /// Clears and draws one frame in `mode`. The mesh must have normals. Returns the
@@ -97,17 +107,21 @@ impl StandardFrame {
     ) -> u64 {
         let mesh = &model.mesh;
         let shader = Self::shader(mesh, view, target);
+        let start = Instant::now();
         self.renderer.begin_frame(target, color, BACKGROUND);
         transform(&shader, mesh.positions.len(), &mut self.cache);
+        let transformed = Instant::now();
         if mode.fills() {
             self.renderer
                 .draw(&shader, &self.cache, &mesh.indices, opts, color);
         }
-        if mode.wires() {
+        let wire = if mode.wires() {
             let depth = mode.fills().then_some(&self.renderer.depth);
             draw_wireframe(&self.cache, &model.edges, target, depth, WIRE_COLOR, color)
         } else {
             0
-        }
+        };
+        self.timing = [transformed - start, transformed.elapsed()];
+        wire
     }
 }

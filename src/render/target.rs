@@ -25,7 +25,9 @@ pub trait ColorTarget {
     }
 }
 
-/// 8-bit RGBA, the PNG format.
+/// 8-bit RGBA. Alpha records coverage: the background is cleared with alpha 0 and
+/// every written fragment has alpha 255 (the terminal leaves uncovered samples to its
+/// own background).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Rgba8(pub Vec<[u8; 4]>);
 
@@ -63,7 +65,7 @@ impl ColorTarget for Rgba8 {
         *dst = lanes.select(px, i32x8::new(*dst)).to_array();
     }
     fn reset(&mut self, len: usize, c: Vec3) {
-        let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255];
+        let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0];
         self.0.clear();
         self.0.resize(len, px);
     }

@@ -1,0 +1,12 @@
+//! The terminal as a framebuffer: sub-sample layouts, glyph and colour selection.
+//!
+//! A cell is covered by `sx × sy` sub-samples (the glyph mode); the rasterizer runs at
+//! sub-sample resolution and each cell's glyph and two colours are fitted to its
+//! samples. Cells are about twice as tall as wide (`cell_aspect` = width / height ≈
+//! 0.5), so a sample's aspect is `cell_aspect · sy / sx`.
+
+pub mod color;
+pub mod glyphs;
+
+pub use color::{ColorMode, Rgb};
+pub use glyphs::{CellGlyph, GlyphMode};

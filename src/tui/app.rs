@@ -292,8 +292,19 @@ impl App {
         let s = self.viewport.frame.renderer.stats;
         let [tf, rs] = self.viewport.frame.timing;
         let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let mode = match self.settings.mode {
+            Mode::Fill => "fill",
+            Mode::Wire => "wire",
+            Mode::FillWire => "fill+wire",
+        };
+        // State first, so it stays visible when a narrow terminal cuts the line.
         Line::from(format!(
-            "{:.0} fps | transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms | tris {} drawn {} culled {} clipped | {} B | {} {} {}{}{} | ? help",
+            "{}{}{} {} {} | {:.0} fps | transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms | tris {} drawn {} culled {} clipped | {} B | ? help",
+            if self.paused { "paused | " } else { "" },
+            if self.inspect { "inspect | " } else { "" },
+            self.settings.glyphs.name(),
+            self.settings.colors.name(),
+            mode,
             self.fps,
             ms(tf),
             ms(rs),
@@ -303,15 +314,6 @@ impl App {
             s.culled,
             s.clipped,
             self.bytes,
-            self.settings.glyphs.name(),
-            self.settings.colors.name(),
-            match self.settings.mode {
-                Mode::Fill => "fill",
-                Mode::Wire => "wire",
-                Mode::FillWire => "fill+wire",
-            },
-            if self.paused { " | paused" } else { "" },
-            if self.inspect { " | inspect" } else { "" },
         ))
     }
 

@@ -1,0 +1,219 @@
+//! Glyph selection, colour detection, and the viewer drawn into ratatui's TestBackend.
+
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+use termrast::render::standard::Model;
+use termrast::render::wire::Mode;
+use termrast::terminal::glyphs::{Sample, braille, fit_cell, sextant};
+use termrast::terminal::{ColorMode, GlyphMode};
+use termrast::tui::app::App;
+use termrast::tui::inspector::{inspector_text, line_at, line_text};
+use termrast::tui::viewport::ViewSettings;
+
+fn s(rgb: [u8; 3]) -> Sample {
+    Sample { rgb, covered: true }
+}
+const OFF: Sample = Sample {
+    rgb: [0, 0, 0],
+    covered: false,
+};
+
+#[test]
+fn half_block_uses_top_as_foreground() {
+    let g = fit_cell(
+        GlyphMode::Half,
+        &[s([200, 10, 10]), s([10, 10, 200])],
+        false,
+    );
+    assert_eq!(
+        (g.ch, g.fg, g.bg),
+        ('▀', Some([200, 10, 10]), Some([10, 10, 200]))
+    );
+    let g = fit_cell(GlyphMode::Half, &[OFF, s([9, 9, 9])], false);
+    assert_eq!((g.ch, g.fg, g.bg), ('▄', Some([9, 9, 9]), None));
+    assert_eq!(fit_cell(GlyphMode::Half, &[OFF, OFF], false).ch, ' ');
+}
+
+#[test]
+fn quadrant_fit_picks_the_bright_half() {
+    // Top half bright, bottom half dark → upper half block, two colours.
+    let w = s([250, 250, 250]);
+    let d = s([20, 20, 20]);
+    let g = fit_cell(GlyphMode::Quadrant, &[w, w, d, d], false);
+    assert_eq!(
+        (g.ch, g.fg, g.bg, g.error),
+        ('▀', Some([250; 3]), Some([20; 3]), 0)
+    );
+    // One covered corner on an empty background.
+    let g = fit_cell(GlyphMode::Quadrant, &[OFF, OFF, OFF, w], false);
+    assert_eq!((g.ch, g.bg), ('▗', None));
+    let g = fit_cell(GlyphMode::Quadrant, &[w, w, w, w], false);
+    assert_eq!(g.ch, '█');
+}
+
+#[test]
+fn braille_and_sextant_bit_layouts() {
+    // Samples are row-major in a 2×4 cell; braille dots 1,2,3,7 run down the left.
+    assert_eq!(braille(0), '\u{2800}');
+    assert_eq!(braille(0b0000_0001), '⠁'); // top-left: dot 1
+    assert_eq!(braille(0b0000_0010), '⠈'); // top-right: dot 4
+    assert_eq!(braille(0b0100_0000), '⡀'); // bottom-left: dot 7
+    assert_eq!(braille(0b1000_0000), '⢀'); // bottom-right: dot 8
+    assert_eq!(braille(0xFF), '⣿');
+    assert_eq!(braille(0b0101_0101), '⡇'); // left column
+    // Sextants: U+1FB00 onwards, skipping the half columns and empty/full.
+    assert_eq!(sextant(1), '\u{1FB00}');
+    assert_eq!(sextant(21), '▌');
+    assert_eq!(sextant(42), '▐');
+    assert_eq!(sextant(22), '\u{1FB14}');
+    assert_eq!(sextant(62), '\u{1FB3B}');
+    assert_eq!(sextant(63), '█');
+    let all: std::collections::HashSet<char> = (0..64).map(sextant).collect();
+    assert_eq!(all.len(), 64, "every pattern has its own glyph");
+}
+
+#[test]
+fn colorless_modes_dither_by_luminance() {
+    let grey = |v: u8| s([v, v, v]);
+    let dots = |v| {
+        fit_cell(GlyphMode::Braille, &[grey(v); 8], true)
+            .pattern
+            .count_ones()
+    };
+    assert_eq!(dots(0), 0);
+    assert_eq!(dots(255), 8);
+    assert!(dots(64) < dots(128) && dots(128) < dots(200));
+    assert_eq!(fit_cell(GlyphMode::Braille, &[grey(255); 8], true).fg, None);
+}
+
+#[test]
+fn colour_detection_table() {
+    let cases: &[(&[(&str, &str)], ColorMode)] = &[
+        (
+            &[("COLORTERM", "truecolor"), ("TERM", "xterm-256color")],
+            ColorMode::Truecolor,
+        ),
+        (&[("COLORTERM", "24bit")], ColorMode::Truecolor),
+        (&[("TERM", "xterm-direct")], ColorMode::Truecolor),
+        (&[("TERM", "xterm-256color")], ColorMode::Ansi256),
+        (&[("TERM", "screen-256color")], ColorMode::Ansi256),
+        (&[("TERM", "xterm")], ColorMode::Ansi16),
+        (&[("TERM", "vt100")], ColorMode::Ansi16),
+        (&[("TERM", "dumb")], ColorMode::None),
+        (&[], ColorMode::None),
+        (
+            &[("NO_COLOR", "1"), ("COLORTERM", "truecolor")],
+            ColorMode::None,
+        ),
+        (
+            &[("NO_COLOR", ""), ("TERM", "xterm-256color")],
+            ColorMode::Ansi256,
+        ),
+    ];
+    for (env, want) in cases {
+        let got = ColorMode::detect(|k| {
+            env.iter()
+                .find(|(n, _)| *n == k)
+                .map(|(_, v)| v.to_string())
+        });
+        assert_eq!(got, *want, "{env:?}");
+    }
+    assert_eq!(
+        ColorMode::Ansi256.color([255, 0, 0]),
+        ratatui::style::Color::Indexed(196)
+    );
+    assert_eq!(
+        ColorMode::Ansi256.color([128, 128, 128]),
+        ratatui::style::Color::Indexed(244)
+    );
+    assert_eq!(
+        ColorMode::Ansi16.color([250, 250, 250]),
+        ratatui::style::Color::White
+    );
+}
+
+fn teapot() -> Model {
+    let mut m = termrast::mesh::Mesh::teapot();
+    m.ensure_normals();
+    Model::new(m)
+}
+
+fn app(glyphs: GlyphMode) -> App {
+    let settings = ViewSettings {
+        glyphs,
+        colors: ColorMode::None,
+        ..ViewSettings::default()
+    };
+    let mut a = App::new(teapot(), settings);
+    a.paused = true;
+    a
+}
+
+/// The screen as text, without the status line's timings (they vary run to run).
+fn screen(t: &Terminal<TestBackend>) -> String {
+    let text = t.backend().to_string();
+    text.lines()
+        .filter(|l| !l.contains(" fps |"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn viewport_snapshots_in_every_glyph_mode() {
+    for mode in GlyphMode::ALL {
+        let mut a = app(mode);
+        let mut t = Terminal::new(TestBackend::new(80, 24)).unwrap();
+        t.draw(|f| a.draw(f)).unwrap();
+        insta::assert_snapshot!(format!("viewport_{}", mode.name()), screen(&t));
+    }
+}
+
+#[test]
+fn inspector_and_line_panel_snapshots() {
+    let mut a = app(GlyphMode::Quadrant);
+    a.inspect = true;
+    a.settings.mode = Mode::FillWire;
+    a.cursor = (31, 19);
+    let mut t = Terminal::new(TestBackend::new(120, 40)).unwrap();
+    t.draw(|f| a.draw(f)).unwrap();
+    let text = inspector_text(&a.viewport, &a.model, a.cursor.0, a.cursor.1, 0);
+    assert!(
+        [
+            "F01", "F02", "F03", "area2", " u ", " v ", " w ", "1/w", "depth", "block"
+        ]
+        .iter()
+        .all(|k| text.contains(k)),
+        "{text}"
+    );
+    insta::assert_snapshot!("inspector_cell_31_19", text);
+    let (x, y) = termrast::tui::inspector::sample_pixel(&a.viewport, 31, 19, 0);
+    let (edge, sl, k) = line_at(&a.viewport, &a.model, x, y).expect("a line near the cell");
+    let panel = line_text(edge, &sl, k);
+    assert!(
+        ["octant", "dx", "dy", "incrE", "incrNE", " d "]
+            .iter()
+            .all(|f| panel.contains(f)),
+        "{panel}"
+    );
+    insta::assert_snapshot!("line_panel_cell_31_19", panel);
+    // Stepping along the line moves the cursor with it.
+    let before = a.cursor;
+    for _ in 0..6 {
+        a.handle(&ratatui::crossterm::event::Event::Key(
+            ratatui::crossterm::event::KeyEvent::from(ratatui::crossterm::event::KeyCode::Char(
+                ']',
+            )),
+        ));
+    }
+    assert_ne!(a.cursor, before);
+    assert_eq!(a.line_focus.map(|f| f.0), Some(edge));
+    insta::assert_snapshot!("screen_inspect", screen(&t));
+}
+
+#[test]
+fn tiny_terminal_gets_a_message() {
+    let mut a = app(GlyphMode::Braille);
+    let mut t = Terminal::new(TestBackend::new(20, 5)).unwrap();
+    t.draw(|f| a.draw(f)).unwrap();
+    assert!(t.backend().to_string().contains("too small"));
+}

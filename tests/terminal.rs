@@ -217,3 +217,52 @@ fn tiny_terminal_gets_a_message() {
     t.draw(|f| a.draw(f)).unwrap();
     assert!(t.backend().to_string().contains("too small"));
 }
+
+mod fit_property {
+    use super::*;
+    use proptest::prelude::*;
+    use termrast::terminal::glyphs::luma;
+
+    /// Brute force: every luminance-ordered split, errors computed from group means.
+    fn best_error(samples: &[Sample]) -> f64 {
+        let mut order: Vec<usize> = (0..samples.len()).collect();
+        let key = |s: &Sample| if s.covered { luma(s.rgb) } else { -1.0 };
+        order.sort_by(|&a, &b| key(&samples[a]).total_cmp(&key(&samples[b])));
+        let sse = |g: &[usize]| -> f64 {
+            if g.is_empty() {
+                return 0.0;
+            }
+            (0..3)
+                .map(|c| {
+                    let v: Vec<f64> = g.iter().map(|&i| f64::from(samples[i].rgb[c])).collect();
+                    let m = v.iter().sum::<f64>() / v.len() as f64;
+                    v.iter().map(|x| (x - m).powi(2)).sum::<f64>()
+                })
+                .sum()
+        };
+        (0..samples.len())
+            .filter(|&cut| order[cut..].iter().all(|&i| samples[i].covered))
+            .map(|cut| sse(&order[..cut]) + sse(&order[cut..]))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    proptest! {
+        #[test]
+        fn two_colour_fit_is_optimal(raw in prop::collection::vec((any::<[u8; 3]>(), 0u8..4), 8)) {
+            let samples: Vec<Sample> = raw.iter().map(|&(rgb, c)| Sample { rgb: if c == 0 { [0; 3] } else { rgb }, covered: c != 0 }).collect();
+            for (mode, n) in [(GlyphMode::Quadrant, 4), (GlyphMode::Sextant, 6), (GlyphMode::Braille, 8)] {
+                let s = &samples[..n];
+                if s.iter().all(|x| !x.covered) {
+                    continue;
+                }
+                let g = fit_cell(mode, s, false);
+                // Integer error with the mean's remainder truncated: within n of exact.
+                let want = best_error(s);
+                prop_assert!((f64::from(g.error) - want).abs() <= n as f64 + 1e-6, "{} vs {}", g.error, want);
+                // Foreground samples are covered ones; the glyph shows exactly them.
+                prop_assert!((0..n).all(|i| g.pattern >> i & 1 == 0 || s[i].covered));
+                prop_assert_eq!(g.ch, mode.pattern_glyph(g.pattern));
+            }
+        }
+    }
+}

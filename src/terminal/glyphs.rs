@@ -279,27 +279,45 @@ pub fn fit_cell(mode: GlyphMode, samples: &[Sample], colorless: bool) -> CellGly
 }
 
 /// The best split of the samples, ordered by luminance, into a dark and a bright group.
+/// Prefix sums of colour and squared colour give each split's squared error
+/// (`Σx² − (Σx)²/n` per channel) in constant time.
 fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph {
     let n = samples.len().min(8);
     let mut order = [0usize, 1, 2, 3, 4, 5, 6, 7];
     let order = &mut order[..n];
     let key = |s: &Sample| if s.covered { luma(s.rgb) } else { -1.0 };
     order.sort_unstable_by(|&a, &b| key(&samples[a]).total_cmp(&key(&samples[b])));
-    let mut best = (u32::MAX, 0usize);
-    for split in 0..n {
-        let (dark, bright) = order.split_at(split);
-        // Uncovered samples in the dark group are the terminal background: black.
-        let e_dark = mean(samples, dark.iter().copied()).map_or(0, |m| err(samples, dark, m));
-        let e_bright = mean(samples, bright.iter().copied()).map_or(0, |m| err(samples, bright, m));
-        // Uncovered samples cannot be foreground.
-        if bright.iter().any(|&i| !samples[i].covered) {
-            continue;
+    // prefix[i] = sums over order[..i]: (Σr, Σg, Σb, Σr²+Σg²+Σb²).
+    let mut prefix = [[0u64; 4]; 9];
+    for (i, &k) in order.iter().enumerate() {
+        let c = samples[k].rgb.map(u64::from);
+        let p = prefix[i];
+        prefix[i + 1] = [
+            p[0] + c[0],
+            p[1] + c[1],
+            p[2] + c[2],
+            p[3] + c[0] * c[0] + c[1] * c[1] + c[2] * c[2],
+        ];
+    }
+    let sse = |from: usize, to: usize| -> u64 {
+        let m = (to - from) as u64;
+        if m == 0 {
+            return 0;
         }
-        if e_dark + e_bright < best.0 {
-            best = (e_dark + e_bright, split);
+        let (a, b) = (prefix[from], prefix[to]);
+        let sq = b[3] - a[3];
+        let lin: u64 = (0..3).map(|c| (b[c] - a[c]).pow(2)).sum();
+        sq - lin / m
+    };
+    // Uncovered samples sort first and can only be background.
+    let first_covered = order.iter().position(|&k| samples[k].covered).unwrap_or(n);
+    let (mut best_err, mut split) = (u64::MAX, first_covered);
+    for cut in first_covered..n {
+        let e = sse(0, cut) + sse(cut, n);
+        if e < best_err {
+            (best_err, split) = (e, cut);
         }
     }
-    let (error, split) = best;
     let (dark, bright) = order.split_at(split);
     let pattern = bright.iter().fold(0u8, |p, &i| p | 1 << i);
     let fg = mean(samples, bright.iter().copied());
@@ -307,6 +325,7 @@ fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph {
         samples,
         dark.iter().copied().filter(|&i| samples[i].covered),
     );
+    let error = u32::try_from(best_err).unwrap_or(u32::MAX);
     CellGlyph {
         ch: mode.pattern_glyph(pattern),
         fg,

@@ -1,5 +1,6 @@
 //! Viewer state, input handling and layout.
 
+use std::fmt::Write as _;
 use std::time::Duration;
 
 use ratatui::Frame;
@@ -45,6 +46,8 @@ pub struct App {
     pub fps: f32,
     pub output_time: Duration,
     pub bytes: u64,
+    /// The status line text, reused every frame.
+    pub status: String,
     drag: Option<(u16, u16)>,
     /// Area of the viewport on screen, from the last draw.
     view_area: Rect,
@@ -68,6 +71,7 @@ impl App {
             fps: 0.0,
             output_time: Duration::ZERO,
             bytes: 0,
+            status: String::with_capacity(256),
             drag: None,
             view_area: Rect::default(),
         }
@@ -243,7 +247,8 @@ impl App {
         if show_panel {
             self.draw_panel(f, panel);
         }
-        f.render_widget(Paragraph::new(self.status_line()), status);
+        self.update_status();
+        f.render_widget(Paragraph::new(Line::from(self.status.as_str())), status);
         if self.help {
             self.draw_help(f, main);
         }
@@ -286,9 +291,9 @@ impl App {
         );
     }
 
-    /// The status line: speed, time split, triangle counts, bytes written.
-    #[must_use]
-    pub fn status_line(&self) -> Line<'static> {
+    /// Rewrites the status line (into a buffer kept across frames): state, speed,
+    /// time split, triangle counts, bytes written.
+    pub fn update_status(&mut self) {
         let s = self.viewport.frame.renderer.stats;
         let [tf, rs] = self.viewport.frame.timing;
         let ms = |d: Duration| d.as_secs_f64() * 1e3;
@@ -298,7 +303,9 @@ impl App {
             Mode::FillWire => "fill+wire",
         };
         // State first, so it stays visible when a narrow terminal cuts the line.
-        Line::from(format!(
+        self.status.clear();
+        let _ = write!(
+            self.status,
             "{}{}{} {} {} | {:.0} fps | transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms | tris {} drawn {} culled {} clipped | {} B | ? help",
             if self.paused { "paused | " } else { "" },
             if self.inspect { "inspect | " } else { "" },
@@ -314,7 +321,7 @@ impl App {
             s.culled,
             s.clipped,
             self.bytes,
-        ))
+        );
     }
 
     fn draw_help(&self, f: &mut Frame, area: Rect) {

@@ -194,16 +194,6 @@ fn mean(samples: &[Sample], idx: impl Iterator<Item = usize> + Clone) -> Option<
     Some(s.map(|v| ((v + n / 2) / n) as u8))
 }
 
-fn err(samples: &[Sample], idx: &[usize], m: Rgb) -> u32 {
-    idx.iter()
-        .map(|&i| {
-            (0..3)
-                .map(|c| (i32::from(samples[i].rgb[c]) - i32::from(m[c])).pow(2) as u32)
-                .sum::<u32>()
-        })
-        .sum()
-}
-
 /// Dither rank of each sample (row-major) per mode: thresholds `(rank + ½) / n` spread
 /// so that brightness fills a cell evenly.
 fn dither_rank(mode: GlyphMode) -> &'static [u8] {

@@ -53,15 +53,6 @@ pub enum LineError {
 #[must_use]
 pub fn trace_table(line: &Line, steps: &[Step]) -> String {
     let mut t = String::new();
-    let refl: Vec<&str> = [
-        (line.swap_ends, "swap endpoints"),
-        (line.swap_xy, "swap x and y"),
-        (line.flip_minor, "flip minor axis"),
-    ]
-    .iter()
-    .filter(|(on, _)| *on)
-    .map(|(_, n)| *n)
-    .collect();
     let _ = writeln!(
         t,
         "line ({},{}) -> ({},{}): octant {}, reflections: {}",
@@ -70,11 +61,7 @@ pub fn trace_table(line: &Line, steps: &[Step]) -> String {
         line.b.0,
         line.b.1,
         line.octant,
-        if refl.is_empty() {
-            "none".to_string()
-        } else {
-            refl.join(", ")
-        }
+        line.reflections()
     );
     let _ = writeln!(
         t,

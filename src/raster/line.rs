@@ -138,6 +138,26 @@ impl Line {
         })
     }
 
+    /// The reflections that reduce this line to the first octant, in words
+    /// (`none` if it is already there).
+    #[must_use]
+    pub fn reflections(&self) -> String {
+        let names: Vec<&str> = [
+            (self.swap_ends, "swap endpoints"),
+            (self.swap_xy, "swap x and y"),
+            (self.flip_minor, "flip minor axis"),
+        ]
+        .iter()
+        .filter(|(on, _)| *on)
+        .map(|(_, n)| *n)
+        .collect();
+        if names.is_empty() {
+            "none".into()
+        } else {
+            names.join(", ")
+        }
+    }
+
     /// The walk's starting pixel.
     #[must_use]
     pub fn start(&self) -> (i64, i64) {

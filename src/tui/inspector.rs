@@ -169,25 +169,7 @@ pub fn line_text(edge: [u32; 2], sl: &ScreenLine, k: i64) -> String {
         "edge v{}-v{}: ({},{}) -> ({},{})",
         edge[0], edge[1], l.a.0, l.a.1, l.b.0, l.b.1
     );
-    let refl: Vec<&str> = [
-        (l.swap_ends, "swap ends"),
-        (l.swap_xy, "swap x,y"),
-        (l.flip_minor, "flip minor"),
-    ]
-    .iter()
-    .filter(|r| r.0)
-    .map(|r| r.1)
-    .collect();
-    let _ = writeln!(
-        t,
-        "octant {}  reflections: {}",
-        l.octant,
-        if refl.is_empty() {
-            "none".into()
-        } else {
-            refl.join(", ")
-        }
-    );
+    let _ = writeln!(t, "octant {}  reflections: {}", l.octant, l.reflections());
     let _ = writeln!(
         t,
         "dx {}  dy {}  incrE {}  incrNE {}",

@@ -6,10 +6,10 @@
 //! and replays the depth test. Its answers therefore equal what the renderer did
 //! (the tests check every pixel of a frame).
 
-use crate::raster::Target;
 use crate::raster::depth::DEPTH_CLEAR;
 use crate::raster::interp::Varying;
 use crate::raster::traverse::{BlockClass, DEFAULT_BLOCK, block_containing, classify_block};
+use crate::raster::{Setup, Target};
 use crate::render::{DrawOptions, PixelEval, Prepared, VertexCache, prepare};
 
 /// Depth-test outcome of one covered fragment.
@@ -30,15 +30,8 @@ pub struct ProbeRecord<V> {
     pub triangle: u32,
     pub piece: u8,
     pub clipped: bool,
-    /// Snapped vertices (subpixels, setup order) and the edge coefficients.
-    pub vertices: [[i64; 2]; 3],
-    pub i: [i64; 3],
-    pub j: [i64; 3],
-    pub k: [i64; 3],
-    pub bias: [i64; 3],
-    pub area2: i64,
-    /// Whether the input winding was flipped.
-    pub flipped: bool,
+    /// The triangle's setup: snapped vertices, I/J/K, bias, doubled area, winding.
+    pub setup: Setup,
     pub eval: PixelEval,
     pub depth: DepthOutcome,
     /// Classification of the pixel's block by the `block` traversal (q = 8).
@@ -106,13 +99,7 @@ pub fn probe<V: Varying>(
                 triangle: p.triangle,
                 piece: p.piece,
                 clipped: p.clipped,
-                vertices: s.v,
-                i: s.i,
-                j: s.j,
-                k: s.k,
-                bias: s.bias,
-                area2: s.area2,
-                flipped: s.flipped,
+                setup: *s,
                 eval,
                 depth,
                 block,

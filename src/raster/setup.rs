@@ -258,19 +258,6 @@ impl Setup {
         self.j.map(|j| j * SUBPIXEL_ONE)
     }
 
-    /// Largest |biased F| of any edge over the pixel rectangle `[x0, x1] × [y0, y1]`.
-    /// Edge functions are affine, so the maximum is at a corner.
-    #[must_use]
-    pub fn max_abs_edge(&self, x0: i64, y0: i64, x1: i64, y1: i64) -> u64 {
-        let mut m = 0u64;
-        for e in 0..3 {
-            for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
-                m = m.max(self.edge(e, x, y).unsigned_abs());
-            }
-        }
-        m
-    }
-
     /// The edge values at the bbox origin, the first value every traversal starts from.
     #[must_use]
     #[inline]

@@ -49,6 +49,8 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
     let view = vp.settings.view();
     let shader = StandardFrame::shader(&model.mesh, &view, vp.target);
     let _ = writeln!(t, "samples ({} per cell):", n);
+    // The selected sample's probe is kept for the overdraw list below.
+    let mut selected = None;
     for k in 0..n {
         let (x, y) = sample_pixel(vp, cx, cy, k);
         let p = probe(&vp.frame.cache, indices, vp.target, &opts, x, y);
@@ -72,9 +74,12 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
                 );
             }
         }
+        if k == sub % n {
+            selected = Some(p);
+        }
     }
     let (x, y) = sample_pixel(vp, cx, cy, sub);
-    let p = probe(&vp.frame.cache, indices, vp.target, &opts, x, y);
+    let Some(p) = selected else { return t };
     let _ = writeln!(t, "sample ({x},{y}), overdraw in draw order:");
     if p.records.is_empty() {
         let _ = writeln!(t, "  no triangle's box holds this sample");
@@ -101,10 +106,10 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
         let _ = writeln!(
             t,
             "   F01 {} F02 {} F03 {}  area2 {}",
-            e.f[0] + r.bias[0],
-            e.f[1] + r.bias[1],
-            e.f[2] + r.bias[2],
-            r.area2
+            e.f[0] + r.setup.bias[0],
+            e.f[1] + r.setup.bias[1],
+            e.f[2] + r.setup.bias[2],
+            r.setup.area2
         );
         let _ = writeln!(
             t,

@@ -89,8 +89,19 @@ pub fn parse_size(s: &str) -> Result<Target, String> {
         }
         Ok(n)
     };
-    Ok(Target::new(side(w, "width")?, side(h, "height")?))
+    let (w, h) = (side(w, "width")?, side(h, "height")?);
+    if u64::from(w) * u64::from(h) > MAX_PIXELS {
+        return Err(format!(
+            "size `{s}` has {} pixels; at most {MAX_PIXELS} (8K) are supported",
+            u64::from(w) * u64::from(h)
+        ));
+    }
+    Ok(Target::new(w, h))
 }
+
+/// Largest target in pixels (2^25, a little over 8K): colour and depth buffers then
+/// stay within about 270 MB instead of failing to allocate.
+pub const MAX_PIXELS: u64 = 1 << 25;
 
 /// Runs the parsed command line, writing errors to stderr.
 pub fn main() -> ExitCode {

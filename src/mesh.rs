@@ -14,6 +14,9 @@ use glam::{Vec2, Vec3};
 /// no files.
 const TEAPOT_OBJ: &str = include_str!("mesh/teapot.obj");
 
+/// Most triangles a built-in sphere may have (`sphere:N`).
+pub const MAX_SPHERE_TRIANGLES: usize = 1 << 22;
+
 /// An indexed triangle mesh. Optional attributes are empty when absent.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
@@ -46,7 +49,9 @@ pub enum MeshError {
     },
     #[error("{path}: no triangles")]
     Empty { path: PathBuf },
-    #[error("unknown built-in model `{0}` (try `teapot`, `sphere:N` or an OBJ path)")]
+    #[error(
+        "unknown built-in model `{0}` (try `teapot`, `sphere:N` with N from 1 to 4194304, or an OBJ path)"
+    )]
     UnknownBuiltin(String),
 }
 
@@ -116,7 +121,9 @@ impl Mesh {
         if let Some(n) = spec.strip_prefix("sphere:") {
             let n: usize = n
                 .parse()
-                .map_err(|_| MeshError::UnknownBuiltin(spec.into()))?;
+                .ok()
+                .filter(|n| (1..=MAX_SPHERE_TRIANGLES).contains(n))
+                .ok_or_else(|| MeshError::UnknownBuiltin(spec.into()))?;
             return Ok(Self::uv_sphere(n));
         }
         let mut m = Self::load(Path::new(spec))?;

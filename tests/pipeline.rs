@@ -4,15 +4,15 @@
 use glam::{Mat4, Vec3, Vec4};
 use termrast::camera::Camera;
 use termrast::mesh::Mesh;
-use termrast::raster::Target;
 use termrast::raster::depth::DEPTH_CLEAR;
 use termrast::raster::interp::{Interpolation, Varying};
 use termrast::raster::probe::{DepthOutcome, probe};
+use termrast::raster::{Target, Traversal};
 use termrast::render::standard::{Model, StandardFrame, StandardView};
 use termrast::render::target::{luminance, to_u8};
 use termrast::render::wire::Mode;
 use termrast::render::{
-    ColorTarget, Cull, DrawOptions, Renderer, Rgba8, Shader, VertexCache, transform,
+    ColorTarget, Cull, DrawOptions, Isa, Renderer, Rgba8, Shader, VertexCache, transform,
 };
 
 /// A colour target that keeps exact f32 colours.
@@ -413,6 +413,113 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
             }
         }
         assert!(winners > 2000, "the bunny covers the frame ({winners})");
+    }
+}
+
+/// Every traversal, on both instruction sets, gives the same framebuffer bit for bit:
+/// coverage is exact, and the fragment paths (`wide`'s `i32x8` edge lanes, the `i64`
+/// fallback, the per-pixel path of the others) perform the same f32 operations.
+#[test]
+fn traversals_and_instruction_sets_draw_identical_frames() {
+    let model = Model::new(bunny());
+    let target = Target::new(160, 120);
+    let frame_of = |traversal: Traversal, isa: Isa, interpolation: Interpolation| {
+        let opts = DrawOptions {
+            traversal,
+            interpolation,
+            ..DrawOptions::default()
+        };
+        let mut frame = StandardFrame::new(target);
+        frame.renderer.isa = isa;
+        let mut color = Rgba8::default();
+        frame.draw(
+            &model,
+            &StandardView::at(0.9),
+            target,
+            &opts,
+            Mode::Fill,
+            &mut color,
+        );
+        let depth: Vec<u32> = frame
+            .renderer
+            .depth
+            .data
+            .iter()
+            .map(|d| d.to_bits())
+            .collect();
+        (color.0, depth)
+    };
+    for interpolation in [Interpolation::Perspective, Interpolation::Affine] {
+        let reference = frame_of(Traversal::Scalar, Isa::Baseline, interpolation);
+        assert!(reference.0.iter().filter(|p| p[3] == 255).count() > 3000);
+        for traversal in Traversal::ALL {
+            for isa in [Isa::Baseline, Isa::detect()] {
+                let got = frame_of(traversal, isa, interpolation);
+                assert!(
+                    got == reference,
+                    "{} on {isa:?} ({interpolation:?}) differs from scalar",
+                    traversal.name()
+                );
+            }
+        }
+    }
+}
+
+/// A triangle far larger than the target takes `wide`'s `i64` fallback (its edge
+/// values do not fit `i32` lanes); it still equals the scalar traversal and the probe.
+#[test]
+fn huge_triangles_take_the_i64_lanes_and_agree() {
+    let target = Target::new(64, 48);
+    let shader = Direct {
+        clip: vec![
+            Vec4::new(-4000.0, -3000.0, 0.5, 1.0),
+            Vec4::new(5000.0, -2500.0, 0.5, 1.0),
+            Vec4::new(300.0, 6000.0, 0.2, 1.0),
+        ],
+        attr: vec![Vec3::X, Vec3::Y, Vec3::Z],
+    };
+    let mut cache = VertexCache::default();
+    transform(&shader, 3, &mut cache);
+    let mut seen = None;
+    termrast::render::prepare(
+        &cache,
+        &[0, 1, 2],
+        0,
+        target,
+        Cull::None,
+        &mut |p: &termrast::render::Prepared<Vec3>| {
+            seen = Some(termrast::raster::traverse::fits_i32(&p.setup));
+        },
+    );
+    assert_eq!(seen, Some(false), "the triangle must need i64 lanes");
+    let frames: Vec<Vec<Option<[u32; 3]>>> = [Traversal::Scalar, Traversal::Wide]
+        .into_iter()
+        .map(|traversal| {
+            let opts = DrawOptions {
+                traversal,
+                ..DrawOptions::default()
+            };
+            let (out, _) = draw(&shader, &[0, 1, 2], target, &opts);
+            out.0
+                .iter()
+                .map(|c| c.map(|c| c.to_array().map(f32::to_bits)))
+                .collect()
+        })
+        .collect();
+    assert_eq!(frames[0], frames[1]);
+    assert!(
+        frames[1].iter().all(Option::is_some),
+        "covers the whole target"
+    );
+    let opts = DrawOptions::default();
+    for (x, y) in [(0, 0), (63, 47), (31, 20)] {
+        let p = probe(&cache, &[0, 1, 2], target, &opts, x, y);
+        let w = p.winner.expect("covered");
+        let c = shader
+            .fragment(&p.records[w].varying)
+            .to_array()
+            .map(f32::to_bits);
+        assert_eq!(frames[1][(y * 64 + x) as usize], Some(c));
     }
 }
 

@@ -65,6 +65,34 @@ fn distances(p: Vec4, guard: [f32; 2]) -> [f32; 6] {
     ]
 }
 
+/// Where a triangle lies against the clip planes, without clipping it: `Inside` (draw
+/// as is), `Rejected` (nothing left) or `Clipped` (call [`clip_triangle`]). Most
+/// triangles of a frame are inside, and this keeps them from building a polygon.
+#[must_use]
+#[inline]
+pub fn classify<V>(tri: &[ClipVertex<V>; 3], guard: [f32; 2]) -> ClipOutcome {
+    if tri.iter().any(|v| !v.pos.is_finite()) {
+        return ClipOutcome::Rejected;
+    }
+    let d = tri.each_ref().map(|v| distances(v.pos, guard));
+    let mut outcome = ClipOutcome::Inside;
+    for plane in 0..6 {
+        let outside = d.iter().filter(|d| d[plane] < 0.0).count();
+        if outside == 3 {
+            return ClipOutcome::Rejected;
+        }
+        if outside > 0 {
+            outcome = ClipOutcome::Clipped;
+        }
+    }
+    // w must be positive after the near plane; w = 0 exactly on every vertex is
+    // caught here too (z ≥ 0 and z ≤ w force w ≥ 0).
+    if outcome == ClipOutcome::Inside && !tri.iter().all(|v| v.pos.w > 0.0) {
+        return ClipOutcome::Rejected;
+    }
+    outcome
+}
+
 /// Clips a triangle. `guard` is the guard band in NDC units for x and y
 /// (see [`guard_band_ndc`]). Returns the outcome and, unless rejected, the polygon.
 pub fn clip_triangle<V: Varying>(
@@ -77,28 +105,9 @@ pub fn clip_triangle<V: Varying>(
     };
     poly.verts[1] = tri[1];
     poly.verts[2] = tri[2];
-    if tri.iter().any(|v| !v.pos.is_finite()) {
-        return (ClipOutcome::Rejected, poly);
-    }
-    let d = tri.map(|v| distances(v.pos, guard));
-    let mut outcome = ClipOutcome::Inside;
-    for plane in 0..6 {
-        let outside = d.iter().filter(|d| d[plane] < 0.0).count();
-        if outside == 3 {
-            return (ClipOutcome::Rejected, poly);
-        }
-        if outside > 0 {
-            outcome = ClipOutcome::Clipped;
-        }
-    }
-    // w must be positive after the near plane; w = 0 exactly on every vertex is
-    // caught here too (z ≥ 0 and z ≤ w force w ≥ 0).
-    if outcome == ClipOutcome::Inside {
-        return if tri.iter().all(|v| v.pos.w > 0.0) {
-            (outcome, poly)
-        } else {
-            (ClipOutcome::Rejected, poly)
-        };
+    let outcome = classify(&tri, guard);
+    if outcome != ClipOutcome::Clipped {
+        return (outcome, poly);
     }
     for plane in 0..6 {
         let mut out = Polygon {

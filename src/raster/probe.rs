@@ -75,7 +75,9 @@ pub fn probe<V: Varying>(
     }
     let mut stored = DEPTH_CLEAR;
     for t in 0..(indices.len() / 3) as u32 {
-        let _ = prepare(cache, indices, t, target, opts.cull, |p: &Prepared<V>| {
+        let _ = prepare(cache, indices, t, target, opts.cull, &mut |p: &Prepared<
+            V,
+        >| {
             let s = &p.setup;
             if !s.bbox.contains(x, y) {
                 return;

@@ -21,7 +21,13 @@ pub const MAX_TARGET_SIDE: u32 = 1 << 16;
 #[inline]
 pub fn snap(v: f64) -> Option<i64> {
     if v.is_finite() && v.abs() <= GUARD_BAND_PX {
-        Some((v * SUBPIXEL_ONE as f64).round() as i64)
+        // `f64::round` is a library call on baseline x86-64 and this runs six times per
+        // triangle. `as` truncates, and `t − trunc(t)` is exact for |t| < 2^52, so the
+        // half-way test on it rounds exactly as `round` does.
+        let t = v * SUBPIXEL_ONE as f64;
+        let i = t as i64;
+        let frac = t - i as f64;
+        Some(i + i64::from(frac >= 0.5) - i64::from(frac <= -0.5))
     } else {
         None
     }
@@ -158,6 +164,8 @@ impl Setup {
         if v.iter().flatten().any(|c| c.abs() > limit) {
             return Err(Reject::BeyondGuardBand);
         }
+        // The box first: at terminal resolutions many triangles hold no pixel centre.
+        let bbox = pixel_bounds(&v, target).ok_or(Reject::Offscreen)?;
         let [a, b, c] = v;
         let area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
         if area2 == 0 {
@@ -184,7 +192,6 @@ impl Setup {
             bias[e] = if left || top { 0 } else { -1 };
         }
 
-        let bbox = pixel_bounds(&v, target).ok_or(Reject::Offscreen)?;
         Ok(Self {
             v,
             flipped,
@@ -228,6 +235,16 @@ impl Setup {
     #[inline]
     pub fn edge(&self, e: usize, x: i64, y: i64) -> i64 {
         self.edge_raw(e, x, y) + self.bias[e]
+    }
+
+    /// `G0e = ⌊(F0e + bias) / 256⌋` at the centre of pixel `(x, y)`: the value the `wide`
+    /// traversal carries in its lanes. At pixel centres `F0e = 256·(I·x + J·y) + c`, so
+    /// `G0e` steps by exactly `I` per pixel and `J` per row, has the sign of the biased
+    /// `F0e`, and `F0e − 256·G0e` is the same for every pixel of the triangle.
+    #[must_use]
+    #[inline]
+    pub fn reduced_edge(&self, e: usize, x: i64, y: i64) -> i64 {
+        self.edge(e, x, y) >> SUBPIXEL_BITS
     }
 
     /// The three biased edge values at a pixel centre.

@@ -5,6 +5,8 @@
 //! masks (`wide`). Sinks are generic parameters, so each traversal is monomorphized
 //! for its sink and nothing is dispatched per pixel.
 
+use wide::i32x8;
+
 /// Receives the pixels a traversal covers. Every pixel reported lies inside the
 /// target and the triangle's bounding box.
 pub trait CoverageSink {
@@ -28,6 +30,17 @@ pub trait CoverageSink {
             self.pixel(x0 + m.trailing_zeros(), y);
             m &= m - 1;
         }
+    }
+
+    /// [`CoverageSink::mask8`] with the traversal's edge lanes: lane `i` of `g[e]` is
+    /// `⌊(F0e + bias) / 256⌋` at the centre of pixel `x0 + i` (see
+    /// [`crate::raster::Setup::reduced_edge`]). A sink that needs the edge values (the
+    /// fragment stage) takes them from here instead of recomputing eight of them per
+    /// edge; lanes outside `mask` hold values too but are not covered.
+    #[inline]
+    fn edges8(&mut self, y: u32, x0: u32, mask: u8, g: &[i32x8; 3]) {
+        let _ = g;
+        self.mask8(y, x0, mask);
     }
 }
 

@@ -54,7 +54,7 @@ impl Traversal {
     }
 
     /// Runs this traversal over one triangle. The match happens once per triangle.
-    #[inline]
+    #[inline(always)]
     pub fn run<S: CoverageSink>(self, setup: &Setup, sink: &mut S) {
         match self {
             Traversal::Scalar => scalar(setup, sink),

@@ -5,6 +5,7 @@ use wide::f32x8;
 
 use super::Shader;
 use crate::mesh::Mesh;
+use crate::raster::map3;
 
 /// The standard light direction (towards the light, world space), normalised.
 #[must_use]
@@ -81,7 +82,7 @@ impl Shader for Lambert<'_> {
         let l = l.simd_gt(f32x8::ZERO).select(l, f32x8::ZERO);
         let a = f32x8::splat(self.ambient);
         let k = a + (f32x8::splat(1.0) - a) * l;
-        [self.base.x, self.base.y, self.base.z].map(|c| f32x8::splat(c) * k)
+        map3(self.base.to_array(), |c| f32x8::splat(c) * k)
     }
 }
 

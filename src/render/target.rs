@@ -1,6 +1,8 @@
 //! Colour targets: what fragments are written into.
 
 use glam::Vec3;
+
+use crate::raster::map3;
 use wide::{f32x8, i32x8};
 
 /// A framebuffer a draw writes shaded fragments into. Generic so the write is
@@ -48,6 +50,14 @@ pub fn to_u8x8(v: f32x8) -> i32x8 {
     (v * f32x8::splat(255.0) + f32x8::splat(0.5)).trunc_int()
 }
 
+/// Lane `k` is all ones when bit `k` of `mask` is set, else zero: a mask for `select`.
+#[must_use]
+#[inline(always)]
+pub fn lanes_of(mask: u8) -> i32x8 {
+    let bits = i32x8::new([1, 2, 4, 8, 16, 32, 64, 128]);
+    (i32x8::splat(i32::from(mask)) & bits).simd_eq(bits)
+}
+
 impl ColorTarget for Rgba8 {
     #[inline(always)]
     fn put(&mut self, index: usize, c: Vec3) {
@@ -56,13 +66,12 @@ impl ColorTarget for Rgba8 {
     #[inline(always)]
     fn put8(&mut self, start: usize, mask: u8, c: &[f32x8; 3]) {
         // Pack to little-endian RGBA words and blend all 8 pixels in one store.
-        let [r, g, b] = c.map(to_u8x8);
+        let [r, g, b] = map3(*c, to_u8x8);
         let px = r | (g << 8) | (b << 16) | i32x8::splat(0xFF << 24);
         let dst: &mut [i32; 8] = bytemuck::cast_slice_mut(&mut self.0[start..start + 8])
             .try_into()
             .expect("8 pixels");
-        let lanes = i32x8::new(std::array::from_fn(|k| -i32::from(mask >> k & 1)));
-        *dst = lanes.select(px, i32x8::new(*dst)).to_array();
+        *dst = lanes_of(mask).select(px, i32x8::new(*dst)).to_array();
     }
     fn reset(&mut self, len: usize, c: Vec3) {
         let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0];

@@ -273,10 +273,23 @@ pub fn fit_cell(mode: GlyphMode, samples: &[Sample], colorless: bool) -> CellGly
 /// (`Σx² − (Σx)²/n` per channel) in constant time.
 fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph {
     let n = samples.len().min(8);
-    let mut order = [0usize, 1, 2, 3, 4, 5, 6, 7];
-    let order = &mut order[..n];
-    let key = |s: &Sample| if s.covered { luma(s.rgb) } else { -1.0 };
-    order.sort_unstable_by(|&a, &b| key(&samples[a]).total_cmp(&key(&samples[b])));
+    // Sort keys: integer Rec. 709 luminance (exact, unlike the f32 one), uncovered
+    // samples first, the sample index in the low bits so ties keep index order.
+    let mut keys = [u32::MAX; 8];
+    for (k, s) in keys.iter_mut().zip(samples).take(n) {
+        let [r, g, b] = s.rgb.map(u32::from);
+        *k = u32::from(s.covered) * (2126 * r + 7152 * g + 722 * b + 1);
+    }
+    for (i, k) in keys.iter_mut().enumerate() {
+        *k = *k << 3 | i as u32;
+    }
+    let keys = &mut keys[..n];
+    keys.sort_unstable();
+    let mut order = [0usize; 8];
+    for (o, k) in order.iter_mut().zip(keys.iter()) {
+        *o = (k & 7) as usize;
+    }
+    let order = &order[..n];
     // prefix[i] = sums over order[..i]: (Σr, Σg, Σb, Σr²+Σg²+Σb²).
     let mut prefix = [[0u64; 4]; 9];
     for (i, &k) in order.iter().enumerate() {

@@ -1,6 +1,6 @@
 use wide::{i32x8, i64x4};
 
-use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup};
+use crate::raster::{CoverageSink, Setup, map3};
 
 /// 8 lanes of edge values, one per pixel of a row group.
 trait Lanes: Copy {
@@ -10,6 +10,8 @@ trait Lanes: Copy {
     fn add(self, o: Self) -> Self;
     /// Bit `i` set when lane `i` is ≥ 0 in all three.
     fn inside_mask(a: Self, b: Self, c: Self) -> u8;
+    /// Hands a group to the sink, with the lanes when the sink can use them.
+    fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u8, f: &[Self; 3]);
 }
 
 impl Lanes for i32x8 {
@@ -30,6 +32,10 @@ impl Lanes for i32x8 {
     fn inside_mask(a: Self, b: Self, c: Self) -> u8 {
         // The OR of three values is negative iff one of them is: one sign-bit mask.
         !((a | b | c).to_bitmask() as u8)
+    }
+    #[inline(always)]
+    fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u8, f: &[Self; 3]) {
+        sink.edges8(y, x0, mask, f);
     }
 }
 
@@ -57,6 +63,11 @@ impl Lanes for Lanes64 {
         let hi = (a.1 | b.1 | c.1).to_bitmask() as u8;
         !(lo | (hi << 4))
     }
+    #[inline(always)]
+    fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u8, _: &[Self; 3]) {
+        // Values that need i64 lanes do not fit the sink's i32 lanes.
+        sink.mask8(y, x0, mask);
+    }
 }
 
 /// The edge values the lanes carry: `G = ⌊F / 256⌋`.
@@ -67,8 +78,8 @@ impl Lanes for Lanes64 {
 /// triangles up to a few thousand pixels within `i32`.
 #[inline(always)]
 fn reduced(s: &Setup) -> ([i64; 3], [i64; 3], [i64; 3]) {
-    let f = s.edges_at_origin().map(|v| v >> SUBPIXEL_BITS);
-    (f, s.i, s.j)
+    let (x, y) = (s.bbox.x0.into(), s.bbox.y0.into());
+    ([0, 1, 2].map(|e| s.reduced_edge(e, x, y)), s.i, s.j)
 }
 
 /// Whether every value the `wide` traversal forms for this setup fits in `i32`: the
@@ -92,6 +103,7 @@ pub fn fits_i32(s: &Setup) -> bool {
 /// (slivers and large triangles skip the empty part of their box), and within it the
 /// lanes step by `8·I` in `i32x8` when the box allows it (almost always), else in two
 /// `i64x4`.
+#[inline(always)]
 pub fn wide<S: CoverageSink>(s: &Setup, sink: &mut S) {
     if fits_i32(s) {
         walk::<i32x8, S>(s, sink);
@@ -142,7 +154,7 @@ fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
             // a group's mask as one byte. Lanes left of the box are masked off.
             let mut x = lo & !7;
             let skip = i64::from(x) - i64::from(b.x0);
-            let mut f = [0, 1, 2].map(|e| L::splat(row[e] + skip * sx[e]).add(ramp[e]));
+            let mut f = map3([0, 1, 2], |e| L::splat(row[e] + skip * sx[e]).add(ramp[e]));
             let mut first = !0u8 << b.x0.saturating_sub(x).min(7);
             loop {
                 let mut m = L::inside_mask(f[0], f[1], f[2]) & first;
@@ -152,7 +164,7 @@ fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
                     m &= (1u8 << (left + 1)) - 1;
                 }
                 if m != 0 {
-                    sink.mask8(y, x, m);
+                    L::emit(sink, y, x, m, &f);
                 }
                 if left < 8 {
                     break;

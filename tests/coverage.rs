@@ -408,3 +408,25 @@ fn wide_takes_the_i64_path_when_i32_would_overflow() {
     assert!(fits_i32(&small) && !fits_i32(&huge));
     assert_all_match_oracle(huge_tri, target);
 }
+
+/// `snap` rounds half away from zero exactly as `f64::round` does (it avoids the
+/// library call), including values one ulp either side of a half.
+#[test]
+fn snap_rounds_like_f64_round() {
+    use termrast::raster::{GUARD_BAND_PX, snap};
+    let reference = |v: f64| (v * 256.0).round() as i64;
+    let mut cases = vec![0.0, -0.0, 2.5 / 256.0, -2.5 / 256.0, GUARD_BAND_PX, -GUARD_BAND_PX];
+    for k in -600i32..600 {
+        let half = (f64::from(k) + 0.5) / 256.0;
+        cases.extend([half, half.next_up(), half.next_down()]);
+    }
+    cases.push(0.499_999_999_999_999_94 / 256.0);
+    for v in cases {
+        assert_eq!(snap(v), Some(reference(v)), "{v:e}");
+    }
+    assert_eq!(snap(GUARD_BAND_PX.next_up()), None);
+    assert_eq!(snap(f64::NAN), None);
+    proptest!(|(v in -GUARD_BAND_PX..=GUARD_BAND_PX)| {
+        prop_assert_eq!(snap(v), Some(reference(v)));
+    });
+}

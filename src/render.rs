@@ -18,7 +18,9 @@ use glam::{Vec3, Vec4};
 
 use crate::raster::clip::{ClipOutcome, ClipVertex, classify, clip_triangle, guard_band_ndc};
 use crate::raster::depth::{DepthBuffer, DepthFunc, DepthState};
-use crate::raster::interp::{Interpolation, Varying, perspective_weights};
+use crate::raster::interp::{
+    Interpolation, Varying, perspective_weights, span_lerp, span_position,
+};
 use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup, Target, Traversal, map3};
 pub use target::{ColorTarget, Luma, Rgba8, lanes_of};
 use wide::{f32x8, i32x8};
@@ -161,6 +163,9 @@ fn edge_value8(g: f32x8, rem: f32) -> f32x8 {
 /// The state of one pixel of one triangle: what the renderer computes per fragment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PixelEval {
+    /// The pixel.
+    pub x: u32,
+    pub y: u32,
     /// Raw `F01, F02, F03` (no fill-rule bias) at the pixel centre.
     pub f: [i64; 3],
     /// Whether the biased test passed (the pixel is covered).
@@ -188,18 +193,13 @@ impl<V: Varying> Prepared<V> {
         let f03 = s.area2 - f01 - f02;
         let f = [f01, f02, f03];
         let covered = (0..3).all(|e| f[e] + s.bias[e] >= 0);
-        // The 8-lane fragment loop performs these same f32 operations in the same order,
-        // so both give identical bits.
-        let fl = [0, 1, 2].map(|e| {
-            let g = (f[e] + s.bias[e]) >> SUBPIXEL_BITS;
-            edge_value(g as f32, self.edge_rem[e])
-        });
-        let ia = self.inv_area2;
-        let bary = [fl[1] * ia, fl[2] * ia, fl[0] * ia];
+        let bary = self.bary_of(f);
         let depth = bary[0] * self.z[0] + bary[1] * self.z[1] + bary[2] * self.z[2];
         let (persp, inv_w) = perspective_weights(bary, self.inv_w);
         PixelEval {
-            f: [f01, f02, f03],
+            x,
+            y,
+            f,
             covered,
             bary,
             persp,
@@ -208,14 +208,50 @@ impl<V: Varying> Prepared<V> {
         }
     }
 
+    /// Screen-space barycentrics from raw edge values, by the same f32 operations in
+    /// the same order as the 8-lane fragment loop (so both give identical bits).
+    #[inline(always)]
+    fn bary_of(&self, f: [i64; 3]) -> [f32; 3] {
+        let s = &self.setup;
+        let fl = map3([0, 1, 2], |e| {
+            let g = (f[e] + s.bias[e]) >> SUBPIXEL_BITS;
+            edge_value(g as f32, self.edge_rem[e])
+        });
+        let ia = self.inv_area2;
+        [fl[1] * ia, fl[2] * ia, fl[0] * ia]
+    }
+
+    /// Perspective-correct weights at the centre of pixel `(x, y)`, which may lie
+    /// outside the triangle (the subdivided modes need them at span ends).
+    #[inline(always)]
+    fn persp_at(&self, x: u32, y: u32) -> [f32; 3] {
+        let s = &self.setup;
+        let (xi, yi) = (i64::from(x), i64::from(y));
+        let f01 = s.edge_raw(0, xi, yi);
+        let f02 = s.edge_raw(1, xi, yi);
+        let f = [f01, f02, s.area2 - f01 - f02];
+        perspective_weights(self.bary_of(f), self.inv_w).0
+    }
+
+    /// The interpolation weights of A, B, C at an evaluated pixel in `mode`.
+    #[inline(always)]
+    #[must_use]
+    pub fn weights(&self, e: &PixelEval, mode: Interpolation) -> [f32; 3] {
+        match (mode, mode.span()) {
+            (Interpolation::Affine, _) => e.bary,
+            (_, Some(n)) => {
+                let (a, t) = span_position(e.x, n);
+                span_lerp(self.persp_at(a, e.y), self.persp_at(a + n, e.y), t)
+            }
+            _ => e.persp,
+        }
+    }
+
     /// Interpolated varyings at an evaluated pixel.
     #[inline(always)]
     #[must_use]
     pub fn varyings(&self, e: &PixelEval, mode: Interpolation) -> V {
-        let w = match mode {
-            Interpolation::Perspective => e.persp,
-            Interpolation::Affine => e.bary,
-        };
+        let w = self.weights(e, mode);
         V::weighted(&self.var[0], &self.var[1], &self.var[2], w)
     }
 }
@@ -501,11 +537,32 @@ impl<S: Shader, C: ColorTarget> Fragments<'_, S, C> {
                 [p[0] * r, p[1] * r, p[2] * r]
             }
             Interpolation::Affine => b,
+            mode => span_weights8(t, mode.span().unwrap_or(8), x0, y),
         };
         let colors = self.shader.fragment8(&t.var, &w, pass);
         self.color.put8(start, pass, &colors);
         self.shaded += u64::from(pass.count_ones());
     }
+}
+
+/// The subdivided modes' weights for the 8 pixels from `x0`: exact perspective weights
+/// at the ends of each pixel's span (computed once per distinct span end), linear in
+/// between, by the same operations as [`Prepared::weights`].
+#[inline(always)]
+fn span_weights8<V: Varying>(t: &Prepared<V>, n: u32, x0: u32, y: u32) -> [f32x8; 3] {
+    let mut out = [[0f32; 8]; 3];
+    let mut ends = (u32::MAX, [0f32; 3], [0f32; 3]);
+    for k in 0..8 {
+        let (a, frac) = span_position(x0 + k, n);
+        if ends.0 != a {
+            ends = (a, t.persp_at(a, y), t.persp_at(a + n, y));
+        }
+        let w = span_lerp(ends.1, ends.2, frac);
+        for v in 0..3 {
+            out[v][k as usize] = w[v];
+        }
+    }
+    out.map(f32x8::new)
 }
 
 /// Rasterizes the pieces of a draw's triangles.

@@ -415,7 +415,14 @@ fn wide_takes_the_i64_path_when_i32_would_overflow() {
 fn snap_rounds_like_f64_round() {
     use termrast::raster::{GUARD_BAND_PX, snap};
     let reference = |v: f64| (v * 256.0).round() as i64;
-    let mut cases = vec![0.0, -0.0, 2.5 / 256.0, -2.5 / 256.0, GUARD_BAND_PX, -GUARD_BAND_PX];
+    let mut cases = vec![
+        0.0,
+        -0.0,
+        2.5 / 256.0,
+        -2.5 / 256.0,
+        GUARD_BAND_PX,
+        -GUARD_BAND_PX,
+    ];
     for k in -600i32..600 {
         let half = (f64::from(k) + 0.5) / 256.0;
         cases.extend([half, half.next_up(), half.next_down()]);

@@ -66,26 +66,33 @@ fn perspective_correct_matches_ray_plane_reference() {
     let target = Target::new(256, 192);
     let camera = Camera::default();
     let vp = camera.projection(target.width, target.height, 1.0) * camera.view();
-    // A slope rising from y = −1 at z = 1 (near the eye) to y = 1 at z = −2.
-    let world = [
+    // A slope rising from y = −1 at z = 1 (near the eye) to y = 1 at z = −2, its texture
+    // coordinates u across and v along it. It is turned about y so depth also varies
+    // along screen rows, which is what the subdivided modes approximate.
+    let slope = [
         Vec3::new(-1.5, -1.0, 1.0),
         Vec3::new(1.5, -1.0, 1.0),
         Vec3::new(1.5, 1.0, -2.0),
         Vec3::new(-1.5, 1.0, -2.0),
     ];
-    let uv = |p: glam::DVec3| glam::DVec3::new((p.x + 1.5) / 3.0, (1.0 - p.z) / 3.0, 0.0);
+    let turn = glam::DQuat::from_rotation_y(0.6);
+    let uv_of_slope = |p: glam::DVec3| glam::DVec3::new((p.x + 1.5) / 3.0, (1.0 - p.z) / 3.0, 0.0);
+    let uv = |world: glam::DVec3| uv_of_slope(turn.inverse() * world);
+    let world = slope.map(|p| (turn * p.as_dvec3()).as_vec3());
     let [a, b, _, d] = world.map(Vec3::as_dvec3);
     let normal = (b - a).cross(d - a);
     let shader = Direct {
         clip: world.iter().map(|p| vp * p.extend(1.0)).collect(),
-        attr: world.iter().map(|p| uv(p.as_dvec3()).as_vec3()).collect(),
+        attr: slope
+            .iter()
+            .map(|p| uv_of_slope(p.as_dvec3()).as_vec3())
+            .collect(),
     };
     let inv_vp = vp.as_dmat4().inverse();
-    let mut errors = [0f32; 2];
-    for (k, mode) in [Interpolation::Perspective, Interpolation::Affine]
-        .into_iter()
-        .enumerate()
-    {
+    // Per mode: the largest error anywhere, and the largest at pixels whose x is a
+    // multiple of 16 (span ends for every subdivided mode).
+    let mut errors = [[0f32; 2]; 5];
+    for (k, mode) in Interpolation::ALL.into_iter().enumerate() {
         let opts = DrawOptions {
             interpolation: mode,
             ..DrawOptions::default()
@@ -97,7 +104,7 @@ fn perspective_correct_matches_ray_plane_reference() {
                 let Some(got) = img.0[(y * target.width + x) as usize] else {
                     continue;
                 };
-                // Ray through the pixel centre, intersected with y = −0.5 in f64.
+                // Ray through the pixel centre, intersected with the slope in f64.
                 let ndc_x = (f64::from(x) + 0.5) / f64::from(target.width) * 2.0 - 1.0;
                 let ndc_y = 1.0 - (f64::from(y) + 0.5) / f64::from(target.height) * 2.0;
                 let far = inv_vp * glam::DVec4::new(ndc_x, ndc_y, 1.0, 1.0);
@@ -106,17 +113,39 @@ fn perspective_correct_matches_ray_plane_reference() {
                 let t = normal.dot(a - eye) / normal.dot(far - eye);
                 let want = uv(eye + (far - eye) * t);
                 let err = (got.as_dvec3() - want).abs().max_element() as f32;
-                errors[k] = errors[k].max(err);
+                errors[k][0] = errors[k][0].max(err);
+                if x % 16 == 0 {
+                    errors[k][1] = errors[k][1].max(err);
+                }
                 n += 1;
             }
         }
         assert!(n > 1000, "quad covers the view");
     }
-    assert!(errors[0] < 1e-4, "perspective error {}", errors[0]);
+    let [affine, perspective, p4, p8, p16] = errors;
     assert!(
-        errors[1] > 0.01,
-        "affine should be visibly wrong, error {}",
-        errors[1]
+        perspective[0] < 1e-4,
+        "perspective error {}",
+        perspective[0]
+    );
+    assert!(
+        affine[0] > 0.01,
+        "affine should be visibly wrong: {}",
+        affine[0]
+    );
+    // Subdivided spans are exact at their ends and err in between, more for longer
+    // spans, but far less than affine.
+    for (name, e) in [("4", p4), ("8", p8), ("16", p16)] {
+        assert!(e[1] < 1e-4, "perspective-{name} at span ends: {}", e[1]);
+        assert!(
+            e[0] > perspective[0],
+            "perspective-{name} errs between ends"
+        );
+        assert!(e[0] < affine[0] / 4.0, "perspective-{name}: {}", e[0]);
+    }
+    assert!(p4[0] < p8[0] && p8[0] < p16[0], "{p4:?} {p8:?} {p16:?}");
+    eprintln!(
+        "max error: affine {affine:?} perspective {perspective:?} 4 {p4:?} 8 {p8:?} 16 {p16:?}"
     );
 }
 
@@ -449,7 +478,7 @@ fn traversals_and_instruction_sets_draw_identical_frames() {
             .collect();
         (color.0, depth)
     };
-    for interpolation in [Interpolation::Perspective, Interpolation::Affine] {
+    for interpolation in Interpolation::ALL {
         let reference = frame_of(Traversal::Scalar, Isa::Baseline, interpolation);
         assert!(reference.0.iter().filter(|p| p[3] == 255).count() > 3000);
         for traversal in Traversal::ALL {

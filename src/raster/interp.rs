@@ -63,10 +63,76 @@ impl<A: Varying, B: Varying> Varying for (A, B) {
 /// How attributes are interpolated across the screen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Interpolation {
-    /// Weights `b_i/w_i / Σ b_j/w_j` (eq. 23): correct under perspective.
+    /// Weights `b_i/w_i / Σ b_j/w_j` (eq. 23) at every pixel: correct under perspective.
     Perspective,
+    /// Perspective-correct at every 4th pixel of a row (x a multiple of 4), linear in
+    /// between: the classic subdivided span of software renderers.
+    #[value(name = "perspective-4")]
+    Perspective4,
+    /// As `perspective-4`, every 8th pixel.
+    #[value(name = "perspective-8")]
+    Perspective8,
+    /// As `perspective-4`, every 16th pixel.
+    #[value(name = "perspective-16")]
+    Perspective16,
     /// Screen-space weights: cheaper, wrong under perspective (kept for comparison).
     Affine,
+}
+
+impl Interpolation {
+    /// Every mode, in table order.
+    pub const ALL: [Interpolation; 5] = [
+        Interpolation::Affine,
+        Interpolation::Perspective,
+        Interpolation::Perspective4,
+        Interpolation::Perspective8,
+        Interpolation::Perspective16,
+    ];
+
+    /// The name used on the command line and in tables.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Interpolation::Perspective => "perspective",
+            Interpolation::Perspective4 => "perspective-4",
+            Interpolation::Perspective8 => "perspective-8",
+            Interpolation::Perspective16 => "perspective-16",
+            Interpolation::Affine => "affine",
+        }
+    }
+
+    /// The span length of the subdivided modes: exact weights at pixels whose x is a
+    /// multiple of it, linear in between.
+    #[must_use]
+    pub fn span(self) -> Option<u32> {
+        match self {
+            Interpolation::Perspective4 => Some(4),
+            Interpolation::Perspective8 => Some(8),
+            Interpolation::Perspective16 => Some(16),
+            Interpolation::Perspective | Interpolation::Affine => None,
+        }
+    }
+}
+
+/// Where pixel `x` lies in its span of length `n`: the span's first pixel and the
+/// fraction `t` of the way to the next span's first pixel. The renderer's lanes and
+/// the probe both use this, so their weights agree bit for bit.
+#[must_use]
+#[inline(always)]
+pub fn span_position(x: u32, n: u32) -> (u32, f32) {
+    let a = x & !(n - 1);
+    (a, (x - a) as f32 / n as f32)
+}
+
+/// Linear interpolation of span-end weights: `wa + (wb − wa)·t` per vertex.
+#[must_use]
+#[inline(always)]
+pub fn span_lerp(wa: [f32; 3], wb: [f32; 3], t: f32) -> [f32; 3] {
+    [
+        wa[0] + (wb[0] - wa[0]) * t,
+        wa[1] + (wb[1] - wa[1]) * t,
+        wa[2] + (wb[2] - wa[2]) * t,
+    ]
 }
 
 /// Perspective-correct weights from screen-space barycentrics `b` and each vertex's

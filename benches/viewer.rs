@@ -16,9 +16,8 @@ use termrast::tui::app::App;
 use termrast::tui::viewport::ViewSettings;
 
 fn bench(c: &mut Criterion) {
-    let bunny = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/bunny.obj");
     let mut g = c.benchmark_group("viewer-frame-200x60-braille");
-    for (name, spec) in [("teapot", "teapot"), ("bunny", bunny)] {
+    for (name, spec) in [("teapot", "teapot"), ("bunny", "bunny")] {
         for colors in [ColorMode::Truecolor, ColorMode::Ansi256] {
             let settings = ViewSettings {
                 glyphs: GlyphMode::Braille,

@@ -2,6 +2,7 @@
 //!
 //! The binary calls [`main`]; everything here is library code so the tests can drive it.
 
+pub mod accuracy_cmd;
 pub mod line_cmd;
 pub mod raster_cmd;
 pub mod render_cmd;
@@ -52,6 +53,9 @@ pub enum Command {
 pub enum BenchCommand {
     /// The standard scene: prints `median_ms=… min_ms=… triangles=… covered_px=… mpx_per_s=…`.
     Render(render_cmd::BenchRenderArgs),
+    /// The accuracy/speed table: every accuracy choice timed and checked against exact
+    /// references (edge arithmetic, traversal, interpolation, anti-aliasing, depth).
+    Accuracy(accuracy_cmd::AccuracyArgs),
 }
 
 /// Errors of the commands, each naming what it is about.
@@ -116,6 +120,9 @@ pub fn main() -> ExitCode {
         }
         Some(Command::Bench(BenchCommand::Render(args))) => render_cmd::bench_render(&args)
             .and_then(|r| writeln!(io::stdout(), "{r}").map_err(Into::into)),
+        Some(Command::Bench(BenchCommand::Accuracy(args))) => {
+            accuracy_cmd::run_cmd(&args, &mut io::stdout().lock())
+        }
         Some(Command::View(args)) => view_cmd::view(&args),
         None => view_cmd::view(&cli.view),
     };

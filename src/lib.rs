@@ -3,6 +3,7 @@
 //! The library holds all of the logic; the `termrast` binary only parses arguments.
 //! Start with [`raster`] for the coverage rules and conventions.
 
+pub mod accuracy;
 pub mod camera;
 pub mod cli;
 pub mod mesh;

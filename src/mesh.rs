@@ -14,6 +14,10 @@ use glam::{Vec2, Vec3};
 /// no files.
 const TEAPOT_OBJ: &str = include_str!("mesh/teapot.obj");
 
+/// The Stanford bunny (Stanford 3D Scanning Repository; 3674 triangles), embedded for
+/// the benchmarks, the accuracy table and the tests.
+const BUNNY_OBJ: &str = include_str!("mesh/bunny.obj");
+
 /// Most triangles a built-in sphere may have (`sphere:N`).
 pub const MAX_SPHERE_TRIANGLES: usize = 1 << 22;
 
@@ -50,7 +54,7 @@ pub enum MeshError {
     #[error("{path}: no triangles")]
     Empty { path: PathBuf },
     #[error(
-        "unknown built-in model `{0}` (try `teapot`, `sphere:N` with N from 1 to 4194304, or an OBJ path)"
+        "unknown built-in model `{0}` (try `teapot`, `bunny`, `sphere:N` with N from 1 to 4194304, or an OBJ path)"
     )]
     UnknownBuiltin(String),
 }
@@ -67,6 +71,15 @@ impl Mesh {
     pub fn teapot() -> Self {
         let mut m = parse_obj(TEAPOT_OBJ, Path::new("teapot")).expect("embedded teapot parses");
         m.name = "teapot".into();
+        m.normalize();
+        m
+    }
+
+    /// The built-in Stanford bunny, normalised, without normals.
+    #[must_use]
+    pub fn bunny() -> Self {
+        let mut m = parse_obj(BUNNY_OBJ, Path::new("bunny")).expect("embedded bunny parses");
+        m.name = "bunny".into();
         m.normalize();
         m
     }
@@ -113,10 +126,12 @@ impl Mesh {
         m
     }
 
-    /// A model by name: `teapot`, `sphere:N`, or a path to an OBJ file.
+    /// A model by name: `teapot`, `bunny`, `sphere:N`, or a path to an OBJ file.
     pub fn from_spec(spec: &str) -> Result<Self, MeshError> {
-        if spec == "teapot" {
-            return Ok(Self::teapot());
+        match spec {
+            "teapot" => return Ok(Self::teapot()),
+            "bunny" => return Ok(Self::bunny()),
+            _ => {}
         }
         if let Some(n) = spec.strip_prefix("sphere:") {
             let n: usize = n

@@ -1,5 +1,10 @@
 //! The 3D pipeline: perspective-correct interpolation, depth, near-plane clipping,
-//! the probe against the framebuffer, and a snapshot.
+//! the probe against the framebuffer, and a snapshot. Near-plane, behind-the-eye and
+//! close-plane cases are in `hard_cases.rs`.
+
+mod common;
+
+use common::{Direct, draw};
 
 use glam::{Mat4, Vec3, Vec4};
 use termrast::camera::Camera;
@@ -11,49 +16,7 @@ use termrast::raster::{Target, Traversal};
 use termrast::render::standard::{Model, StandardFrame, StandardView};
 use termrast::render::target::{luminance, to_u8};
 use termrast::render::wire::Mode;
-use termrast::render::{
-    ColorTarget, Cull, DrawOptions, Isa, Renderer, Rgba8, Shader, VertexCache, transform,
-};
-
-/// A colour target that keeps exact f32 colours.
-#[derive(Default)]
-struct Exact(Vec<Option<Vec3>>);
-
-impl ColorTarget for Exact {
-    fn put(&mut self, i: usize, c: Vec3) {
-        self.0[i] = Some(c);
-    }
-    fn reset(&mut self, len: usize, _: Vec3) {
-        self.0.clear();
-        self.0.resize(len, None);
-    }
-}
-
-/// Clip-space vertices given directly, with a Vec3 attribute each.
-struct Direct {
-    clip: Vec<Vec4>,
-    attr: Vec<Vec3>,
-}
-
-impl Shader for Direct {
-    type Varying = Vec3;
-    fn vertex(&self, i: u32) -> (Vec4, Vec3) {
-        (self.clip[i as usize], self.attr[i as usize])
-    }
-    fn fragment(&self, v: &Vec3) -> Vec3 {
-        *v
-    }
-}
-
-fn draw(shader: &Direct, indices: &[u32], target: Target, opts: &DrawOptions) -> (Exact, Renderer) {
-    let mut r = Renderer::new(target);
-    let mut out = Exact::default();
-    let mut cache = VertexCache::default();
-    r.begin_frame(target, &mut out, Vec3::ZERO);
-    transform(shader, shader.clip.len(), &mut cache);
-    r.draw(shader, &cache, indices, opts, &mut out);
-    (out, r)
-}
+use termrast::render::{Cull, DrawOptions, Isa, Rgba8, Shader, VertexCache, transform};
 
 /// A quad tilted in depth whose attribute is its texture coordinate (u across, v along
 /// the slope), checked against the analytic ray–plane intersection in f64.
@@ -187,58 +150,6 @@ fn interpolation_properties() {
 }
 
 #[test]
-fn close_planes_sort_when_the_gap_is_resolvable() {
-    let target = Target::new(16, 16);
-    let camera = Camera::default();
-    let proj = camera.projection(16, 16, 1.0);
-    let quad = |d: f32| -> Vec<Vec4> {
-        [[-5.0, -5.0], [5.0, -5.0], [5.0, 5.0], [-5.0, 5.0]]
-            .iter()
-            .map(|p| proj * Vec4::new(p[0] * d, p[1] * d, -d, 1.0))
-            .collect()
-    };
-    let ndc = |d: f32| {
-        let c = proj * Vec4::new(0.0, 0.0, -d, 1.0);
-        c.z / c.w
-    };
-    let mut checked = 0;
-    for depth in [0.2f32, 0.5, 1.0, 2.0, 5.0, 9.0] {
-        for gap in [1e-1f32, 1e-2, 1e-3, 1e-4, 1e-5] {
-            let (near, far) = (depth, depth + gap);
-            // Resolvable: the planes land more than 2 f32 steps apart in depth.
-            let (zn, zf) = (ndc(near), ndc(far));
-            let resolvable =
-                zf - zn > 2.0 * (zf.to_bits() as f32 - zf.to_bits() as f32 + f32::EPSILON * zf);
-            if !resolvable {
-                continue;
-            }
-            for order in [[near, far], [far, near]] {
-                let mut clip = quad(order[0]);
-                clip.extend(quad(order[1]));
-                let attr = [Vec3::X; 4].into_iter().chain([Vec3::Y; 4]).collect();
-                let near_colour = if order[0] == near { Vec3::X } else { Vec3::Y };
-                let shader = Direct { clip, attr };
-                let (img, _) = draw(
-                    &shader,
-                    &[0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7],
-                    target,
-                    &DrawOptions::default(),
-                );
-                assert!(
-                    img.0.iter().all(|c| *c == Some(near_colour)),
-                    "depth {depth} gap {gap}"
-                );
-                checked += 1;
-            }
-        }
-    }
-    assert!(
-        checked >= 30,
-        "most cases are resolvable in f32 ({checked})"
-    );
-}
-
-#[test]
 fn interpenetrating_triangles_split_along_their_intersection() {
     // Two triangles crossing at view depth z = −2: the left half of one is in front.
     let target = Target::new(64, 64);
@@ -280,110 +191,8 @@ fn interpenetrating_triangles_split_along_their_intersection() {
     assert!(seen[0] > 100 && seen[1] > 100);
 }
 
-#[test]
-fn near_plane_straddling_renders_exactly_the_front_part() {
-    // Clip space chosen so the near-plane crossings are at t = 1/2 exactly (z goes
-    // from −1 to 1 along the cut edges): clipping is exact in f32, and the result
-    // must equal drawing the hand-clipped quad.
-    let target = Target::new(64, 48);
-    let a = Vec4::new(-0.5, -0.5, 0.5, 1.0);
-    let b = Vec4::new(0.6, -0.4, 0.5, 1.0);
-    let c = Vec4::new(0.1, 0.7, -0.5, 1.0); // z < 0: in front of the eye but before near
-    let attr = vec![Vec3::X, Vec3::Y, Vec3::Z];
-    let (img, r) = draw(
-        &Direct {
-            clip: vec![a, b, c],
-            attr: attr.clone(),
-        },
-        &[0, 1, 2],
-        target,
-        &DrawOptions::default(),
-    );
-    assert_eq!(r.stats.clipped, 1);
-    let mid = |p: Vec4, q: Vec4| (p + q) * 0.5;
-    let quad = vec![a, b, mid(b, c), mid(a, c)];
-    let qattr = vec![
-        Vec3::X,
-        Vec3::Y,
-        (Vec3::Y + Vec3::Z) * 0.5,
-        (Vec3::X + Vec3::Z) * 0.5,
-    ];
-    let (want, _) = draw(
-        &Direct {
-            clip: quad,
-            attr: qattr,
-        },
-        &[0, 1, 2, 0, 2, 3],
-        target,
-        &DrawOptions::default(),
-    );
-    let covered = |e: &Exact| e.0.iter().map(Option::is_some).collect::<Vec<_>>();
-    assert_eq!(covered(&img), covered(&want));
-    for (g, w) in img.0.iter().zip(&want.0) {
-        if let (Some(g), Some(w)) = (g, w) {
-            assert!((*g - *w).abs().max_element() < 1e-5);
-        }
-    }
-}
-
-#[test]
-fn vertices_behind_or_at_the_eye_never_leak() {
-    let target = Target::new(48, 32);
-    let front = Vec4::new(0.0, 0.5, 0.5, 1.0);
-    let cases = [
-        ("w < 0", Vec4::new(0.3, -0.4, -0.8, -0.5)),
-        ("w = 0", Vec4::new(0.3, -0.4, 0.0, 0.0)),
-        ("w = 1e-30", Vec4::new(0.3, -0.4, 1e-31, 1e-30)),
-        ("w = -0", Vec4::new(0.3, -0.4, -0.0, -0.0)),
-        ("nan", Vec4::new(f32::NAN, 0.0, 0.5, 1.0)),
-        ("inf", Vec4::new(f32::INFINITY, 0.0, 0.5, 1.0)),
-    ];
-    for (name, bad) in cases {
-        for (i0, i1) in [(0, 1), (1, 0)] {
-            let clip = vec![front, Vec4::new(-0.6, -0.6, 0.5, 1.0), bad];
-            let mut idx = [0u32, 1, 2];
-            idx.swap(i0, i1);
-            let (img, r) = draw(
-                &Direct {
-                    clip,
-                    attr: vec![Vec3::ONE; 3],
-                },
-                &idx,
-                target,
-                &DrawOptions::default(),
-            );
-            for (i, c) in img.0.iter().enumerate() {
-                if c.is_some() {
-                    let d = r.depth.data[i];
-                    assert!(
-                        d.is_finite() && (0.0..=1.0).contains(&d),
-                        "{name}: depth {d}"
-                    );
-                }
-            }
-        }
-        // Entirely behind the eye: nothing at all.
-        let clip = vec![
-            Vec4::new(0.0, 0.0, -1.0, -1.0),
-            Vec4::new(0.5, 0.0, -1.0, -1.0),
-            bad,
-        ];
-        let (img, r) = draw(
-            &Direct {
-                clip,
-                attr: vec![Vec3::ONE; 3],
-            },
-            &[0, 1, 2],
-            target,
-            &DrawOptions::default(),
-        );
-        assert!(img.0.iter().all(Option::is_none), "{name}");
-        assert_eq!(r.stats.rejected, 1);
-    }
-}
-
 fn bunny() -> Mesh {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/bunny.obj");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/src/mesh/bunny.obj");
     let mut m = Mesh::from_spec(path).expect("bunny loads");
     m.ensure_normals();
     m

@@ -17,7 +17,7 @@ use crate::render::{Cull, DrawOptions, Rgba8};
 /// Options shared by the 3D commands.
 #[derive(Debug, Args)]
 pub struct SceneArgs {
-    /// `teapot` (built in), `sphere:N` (UV sphere of about N triangles) or an OBJ path.
+    /// `teapot` or `bunny` (built in), `sphere:N` (UV sphere of about N triangles) or an OBJ path.
     #[arg(default_value = "teapot")]
     pub model: String,
     /// Skip back faces.

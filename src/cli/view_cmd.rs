@@ -54,7 +54,7 @@ impl LookArgs {
 /// Arguments of the viewer.
 #[derive(Debug, Args, Clone)]
 pub struct ViewArgs {
-    /// `teapot` (built in), `sphere:N` or an OBJ path.
+    /// `teapot` or `bunny` (built in), `sphere:N` or an OBJ path.
     #[arg(default_value = "teapot")]
     pub model: String,
     #[command(flatten)]

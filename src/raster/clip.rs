@@ -125,11 +125,7 @@ pub fn clip_triangle<V: Varying>(
                 out.len += 1;
             }
             if (da >= 0.0) != (db >= 0.0) {
-                let t = da / (da - db);
-                out.verts[out.len] = ClipVertex {
-                    pos: a.pos + (b.pos - a.pos) * t,
-                    var: V::lerp(&a.var, &b.var, t),
-                };
+                out.verts[out.len] = intersect(a, b, da, db, plane, guard);
                 out.len += 1;
             }
         }
@@ -146,6 +142,55 @@ pub fn clip_triangle<V: Varying>(
         return (ClipOutcome::Rejected, poly);
     }
     (ClipOutcome::Clipped, poly)
+}
+
+/// Where edge a→b crosses a plane, given the signed distances of its ends (one ≥ 0,
+/// one < 0).
+///
+/// Interpolated from the inside end. That end is inside whichever triangle the edge
+/// belongs to, so two triangles sharing the edge (which walk it in opposite
+/// directions) compute the very same point, bit for bit: otherwise the clipped shared
+/// edge would be two slightly different lines that can crack or double-hit pixels.
+/// It is also the accurate way round: the step from the inside end is short next to
+/// a far outside end (10^12 at the guard band, where stepping back from the outside
+/// end would cancel catastrophically).
+///
+/// The result is then put exactly on the plane (`z = 0`, `z = w`, `x = ±g·w`,
+/// `y = ±g·w`): when both ends are huge (a triangle reaching 10^12 in clip space) the
+/// interpolated coordinate cancels, and without this the point can land beyond the
+/// guard band and the visible part of the triangle be rejected.
+#[inline]
+fn intersect<V: Varying>(
+    a: ClipVertex<V>,
+    b: ClipVertex<V>,
+    da: f32,
+    db: f32,
+    plane: usize,
+    guard: [f32; 2],
+) -> ClipVertex<V> {
+    let (inside, outside, di, dout) = if da >= 0.0 {
+        (a, b, da, db)
+    } else {
+        (b, a, db, da)
+    };
+    let t = di / (di - dout);
+    let mut pos = inside.pos + (outside.pos - inside.pos) * t;
+    match plane {
+        0 => pos.z = 0.0,
+        1 => pos.z = pos.w,
+        2 => pos.x = guard[0] * pos.w,
+        3 => pos.x = -guard[0] * pos.w,
+        4 => pos.y = guard[1] * pos.w,
+        _ => pos.y = -guard[1] * pos.w,
+    }
+    // The near and far planes came first, so the point lies within 0 ≤ z ≤ w up to
+    // rounding of the interpolation; keep it there so no depth goes below 0. (Not
+    // `clamp`, which panics when w < 0; such points are rejected afterwards.)
+    pos.z = pos.z.max(0.0).min(pos.w);
+    ClipVertex {
+        pos,
+        var: V::lerp(&inside.var, &outside.var, t),
+    }
 }
 
 /// The guard band in NDC units for a `width × height` target: a vertex within it maps

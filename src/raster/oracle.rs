@@ -57,8 +57,16 @@ pub fn covers(tri: [[f64; 2]; 3], x: i64, y: i64) -> bool {
 #[must_use]
 pub fn coverage(tri: [[f64; 2]; 3], width: u32, height: u32) -> Vec<bool> {
     let mut out = vec![false; width as usize * height as usize];
-    let Some(p) = prepare(tri) else { return out };
-    // Only the pixels near the snapped bounds can be covered; the rest stay false.
+    for_each_covered(tri, width, height, |x, y| {
+        out[y as usize * width as usize + x as usize] = true;
+    });
+    out
+}
+
+/// Calls `f(x, y)` for each covered pixel of a `width × height` target, in row-major
+/// order. Only the pixels near the snapped bounds are tested.
+pub fn for_each_covered(tri: [[f64; 2]; 3], width: u32, height: u32, mut f: impl FnMut(u32, u32)) {
+    let Some(p) = prepare(tri) else { return };
     let lo = |c: usize| p.iter().map(|v| v[c]).min().unwrap_or(0).div_euclid(256) - 1;
     let hi = |c: usize| p.iter().map(|v| v[c]).max().unwrap_or(0).div_euclid(256) + 1;
     let xs = lo(0).max(0)..=hi(0).min(i128::from(width) - 1);
@@ -66,11 +74,10 @@ pub fn coverage(tri: [[f64; 2]; 3], width: u32, height: u32) -> Vec<bool> {
     for y in ys {
         for x in xs.clone() {
             if covers_prepared(&p, x as i64, y as i64) {
-                out[y as usize * width as usize + x as usize] = true;
+                f(x as u32, y as u32);
             }
         }
     }
-    out
 }
 
 /// Doubled signed area of the snapped triangle in subpixel² units (positive for the

@@ -1,7 +1,9 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+use glam::{Vec3, Vec4};
 use termrast::raster::{CountGrid, CoverageSink, Setup, Target, Traversal, oracle};
+use termrast::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache, transform};
 
 /// A sink that checks every reported pixel lies in the target and the bbox.
 pub struct CheckedGrid {
@@ -76,4 +78,49 @@ pub fn accumulate(grid: &mut CountGrid, tri: [[f64; 2]; 3], t: Traversal) {
     if let Ok(s) = Setup::new(tri, target) {
         t.run(&s, grid);
     }
+}
+
+/// A colour target that keeps exact f32 colours.
+#[derive(Default)]
+pub struct Exact(pub Vec<Option<Vec3>>);
+
+impl ColorTarget for Exact {
+    fn put(&mut self, i: usize, c: Vec3) {
+        self.0[i] = Some(c);
+    }
+    fn reset(&mut self, len: usize, _: Vec3) {
+        self.0.clear();
+        self.0.resize(len, None);
+    }
+}
+
+/// Clip-space vertices given directly, with a Vec3 attribute each.
+pub struct Direct {
+    pub clip: Vec<Vec4>,
+    pub attr: Vec<Vec3>,
+}
+
+impl Shader for Direct {
+    type Varying = Vec3;
+    fn vertex(&self, i: u32) -> (Vec4, Vec3) {
+        (self.clip[i as usize], self.attr[i as usize])
+    }
+    fn fragment(&self, v: &Vec3) -> Vec3 {
+        *v
+    }
+}
+
+pub fn draw(
+    shader: &Direct,
+    indices: &[u32],
+    target: Target,
+    opts: &DrawOptions,
+) -> (Exact, Renderer) {
+    let mut r = Renderer::new(target);
+    let mut out = Exact::default();
+    let mut cache = VertexCache::default();
+    r.begin_frame(target, &mut out, Vec3::ZERO);
+    transform(shader, shader.clip.len(), &mut cache);
+    r.draw(shader, &cache, indices, opts, &mut out);
+    (out, r)
 }

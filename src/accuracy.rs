@@ -1,0 +1,582 @@
+//! What accuracy costs in time: the variants of `termrast bench accuracy`, the
+//! workloads they run on, and the exact references their errors are measured against.
+//!
+//! Every variant is a real code path:
+//!
+//! | family | variants | reference |
+//! |---|---|---|
+//! | edge arithmetic ([`edge`]) | `f32-direct`, `f32-incremental`, `f64`, `fixed4`, `fixed8`, `i64` | the i128 oracle on the 1/256 px grid |
+//! | traversal | `scalar`, `seed-simd`, `block`, `wide` | the oracle |
+//! | interpolation | `affine`, `perspective`, `perspective-4/8/16` (the renderer's modes) | ray–plane intersection in f64 |
+//! | anti-aliasing ([`area`]) | `1x`, `4x`, `16x` samples per pixel | exact area of triangle ∩ pixel |
+//! | depth ([`depth`]) | `depth-f32`, `depth-unorm24`, `depth-unorm16`, `depth-f32-reversed` | the known nearer of two close planes |
+//!
+//! Times are the median of repeated runs of a whole workload; errors come from one
+//! more run recorded in full. [`cases`] holds the hard cases the stability suite and
+//! the table share.
+
+pub mod area;
+pub mod cases;
+pub mod depth;
+pub mod edge;
+pub mod workloads;
+
+use std::time::Instant;
+
+use glam::{Mat4, Vec2, Vec3};
+
+use self::area::{SAMPLE_COUNTS, Supersampled, aa_name, pixel_areas, snapped, supersample};
+use self::depth::{DepthFormat, DepthPass};
+use self::edge::EdgeArith;
+use self::workloads::{Scene3, UvShader, WORKLOADS};
+use crate::raster::interp::Interpolation;
+use crate::raster::{BitMask, CountGrid, CoverageSink, Setup, Target, Traversal};
+use crate::render::{ColorTarget, DrawOptions, Renderer, VertexCache, transform};
+use crate::workload::Tri2;
+
+/// A family of variants: one accuracy choice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Family {
+    Edge,
+    Traversal,
+    Interpolation,
+    AntiAliasing,
+    Depth,
+}
+
+impl Family {
+    /// Every family, in table order.
+    pub const ALL: [Family; 5] = [
+        Family::Edge,
+        Family::Traversal,
+        Family::Interpolation,
+        Family::AntiAliasing,
+        Family::Depth,
+    ];
+
+    /// The name in tables and CSV.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Family::Edge => "edge",
+            Family::Traversal => "traversal",
+            Family::Interpolation => "interpolation",
+            Family::AntiAliasing => "anti-aliasing",
+            Family::Depth => "depth",
+        }
+    }
+
+    /// What the family's error column measures.
+    #[must_use]
+    pub fn error_name(self) -> &'static str {
+        match self {
+            Family::Edge | Family::Traversal => "coverage mismatches vs oracle (px)",
+            Family::Interpolation => "max attribute error (px)",
+            Family::AntiAliasing => "mean |coverage − area| per pixel",
+            Family::Depth => "z-fighting rate",
+        }
+    }
+}
+
+/// Which sizes and how much work.
+#[derive(Clone, Debug)]
+pub struct Config {
+    pub sizes: Vec<Target>,
+    /// Scales the triangle counts of the tiny and sliver workloads.
+    pub scale: f64,
+    /// Timed runs per measurement (the median is reported).
+    pub repeats: usize,
+}
+
+impl Config {
+    /// Every workload at 80×24, 200×60 and 1920×1080.
+    #[must_use]
+    pub fn full() -> Self {
+        Self {
+            sizes: vec![
+                Target::new(80, 24),
+                Target::new(200, 60),
+                Target::new(1920, 1080),
+            ],
+            scale: 1.0,
+            repeats: 5,
+        }
+    }
+
+    /// Terminal sizes only, thinner workloads, fewer repeats: every variant, in
+    /// seconds.
+    #[must_use]
+    pub fn quick() -> Self {
+        Self {
+            sizes: vec![Target::new(80, 24), Target::new(200, 60)],
+            scale: 0.5,
+            repeats: 5,
+        }
+    }
+}
+
+/// Errors of one measurement; `None` where a measure does not apply.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Errors {
+    /// Pixels where coverage differs from the oracle, summed over triangles.
+    pub mismatches: Option<u64>,
+    /// Pixels covered by no triangle / by several, for workloads that tile the target.
+    pub holes: Option<u64>,
+    pub double_hits: Option<u64>,
+    /// Largest and mean absolute attribute error (uv units).
+    pub attr_max: Option<f64>,
+    pub attr_mean: Option<f64>,
+    /// The same in pixels: the error divided by how far the exact attribute moves
+    /// between neighbouring pixels (so the far end of a grazing floor, where one pixel
+    /// spans many texels, does not drown everything else).
+    pub attr_max_px: Option<f64>,
+    pub attr_mean_px: Option<f64>,
+    /// Mean and largest |coverage − exact area| per touched pixel.
+    pub aa_mean: Option<f64>,
+    pub aa_max: Option<f64>,
+    /// Fraction of pixels where the farther of two close planes won.
+    pub zfight: Option<f64>,
+}
+
+/// One variant on one workload at one size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub family: Family,
+    pub variant: &'static str,
+    pub workload: &'static str,
+    pub target: Target,
+    /// Triangles (or clipped pieces) per run.
+    pub triangles: u64,
+    /// Pixels (fragments, samples resolved to pixels) produced per run.
+    pub pixels: u64,
+    /// Median time of one run, nanoseconds.
+    pub median_ns: f64,
+    pub errors: Errors,
+}
+
+impl Row {
+    /// Nanoseconds per triangle.
+    #[must_use]
+    pub fn ns_per_triangle(&self) -> f64 {
+        self.median_ns / self.triangles.max(1) as f64
+    }
+
+    /// Million pixels per second.
+    #[must_use]
+    pub fn mpx_per_s(&self) -> f64 {
+        self.pixels as f64 / self.median_ns.max(1.0) * 1e3
+    }
+}
+
+/// Shortest timed sample: runs shorter than this are repeated within one sample, so
+/// microsecond workloads (80×24) are not lost in timer and scheduler noise.
+const MIN_SAMPLE_NS: f64 = 2e6;
+
+/// Median wall time of one run of `f` over `repeats` samples, in nanoseconds.
+fn median_ns(repeats: usize, mut f: impl FnMut()) -> f64 {
+    let start = Instant::now();
+    f();
+    let once = start.elapsed().as_secs_f64() * 1e9;
+    let inner = (MIN_SAMPLE_NS / once.max(1.0)).ceil().clamp(1.0, 100_000.0) as usize;
+    let mut t: Vec<f64> = (0..repeats.max(1))
+        .map(|_| {
+            let start = Instant::now();
+            for _ in 0..inner {
+                f();
+            }
+            start.elapsed().as_secs_f64() * 1e9 / inner as f64
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[t.len() / 2]
+}
+
+/// A bit mask that also counts what it is sent (the timing sink).
+struct Counted {
+    mask: BitMask,
+    n: u64,
+}
+
+impl CoverageSink for Counted {
+    #[inline]
+    fn pixel(&mut self, x: u32, y: u32) {
+        self.mask.pixel(x, y);
+        self.n += 1;
+    }
+    #[inline]
+    fn span(&mut self, y: u32, x0: u32, x1: u32) {
+        self.mask.span(y, x0, x1);
+        self.n += u64::from(x1 - x0);
+    }
+    #[inline]
+    fn mask8(&mut self, y: u32, x0: u32, mask: u8) {
+        self.mask.mask8(y, x0, mask);
+        self.n += u64::from(mask.count_ones());
+    }
+}
+
+/// Coverage errors of a rasterizer (`raster(tri, sink)`) against the oracle's pixels.
+fn coverage_errors(
+    tris: &[Tri2],
+    oracle: &[Vec<(u32, u32)>],
+    target: Target,
+    watertight: bool,
+    mut raster: impl FnMut(Tri2, &mut Vec<(u32, u32)>),
+) -> Errors {
+    let mut grid = watertight.then(|| CountGrid::new(target.width, target.height));
+    let mut got = Vec::new();
+    let mut mismatches = 0;
+    for (tri, want) in tris.iter().zip(oracle) {
+        got.clear();
+        raster(*tri, &mut got);
+        if let Some(g) = grid.as_mut() {
+            for &(x, y) in &got {
+                g.counts[y as usize * target.width as usize + x as usize] += 1;
+            }
+        }
+        got.sort_unstable_by_key(|&(x, y)| (y, x));
+        mismatches += cases::symmetric_difference(&got, want);
+    }
+    Errors {
+        mismatches: Some(mismatches),
+        holes: grid
+            .as_ref()
+            .map(|g| g.counts.iter().filter(|&&c| c == 0).count() as u64),
+        double_hits: grid.map(|g| g.counts.iter().filter(|&&c| c > 1).count() as u64),
+        ..Errors::default()
+    }
+}
+
+/// Median time of rasterizing every triangle with `f` into `sink`, and the pixels
+/// sent. Generic so the rasterizer inlines: nothing is dispatched per triangle.
+fn time_coverage<F: Fn(Tri2, &mut Counted)>(
+    tris: &[Tri2],
+    repeats: usize,
+    sink: &mut Counted,
+    f: F,
+) -> (f64, u64) {
+    let ns = median_ns(repeats, || {
+        sink.mask.clear();
+        sink.n = 0;
+        for &t in tris {
+            f(t, sink);
+        }
+    });
+    (ns, sink.n)
+}
+
+/// The edge-arithmetic and traversal rows of one 2D workload.
+fn coverage_rows(
+    workload: &'static str,
+    tris: &[Tri2],
+    target: Target,
+    config: &Config,
+    rows: &mut Vec<Row>,
+) {
+    let oracle: Vec<Vec<(u32, u32)>> = tris
+        .iter()
+        .map(|&t| cases::oracle_pixels(t, target))
+        .collect();
+    let watertight = matches!(workload, "large" | "slivers");
+    let mut sink = Counted {
+        mask: BitMask::new(target.width, target.height),
+        n: 0,
+    };
+    for v in EdgeArith::ALL {
+        let (ns, pixels) = time_coverage(tris, config.repeats, &mut sink, |t, s| {
+            v.rasterize(t, target, s);
+        });
+        let errors = coverage_errors(tris, &oracle, target, watertight, |t, out| {
+            v.rasterize(t, target, out);
+        });
+        rows.push(Row {
+            family: Family::Edge,
+            variant: v.name(),
+            workload,
+            target,
+            triangles: tris.len() as u64,
+            pixels,
+            median_ns: ns,
+            errors,
+        });
+    }
+    for tr in Traversal::ALL {
+        let (ns, pixels) = time_coverage(tris, config.repeats, &mut sink, |t, s| {
+            if let Ok(setup) = Setup::new(t, target) {
+                tr.run(&setup, s);
+            }
+        });
+        let errors = coverage_errors(tris, &oracle, target, watertight, |t, out| {
+            if let Ok(setup) = Setup::new(t, target) {
+                tr.run(&setup, out);
+            }
+        });
+        rows.push(Row {
+            family: Family::Traversal,
+            variant: tr.name(),
+            workload,
+            target,
+            triangles: tris.len() as u64,
+            pixels,
+            median_ns: ns,
+            errors,
+        });
+    }
+}
+
+/// The anti-aliasing rows of one 2D workload.
+fn aa_rows(
+    workload: &'static str,
+    tris: &[Tri2],
+    target: Target,
+    config: &Config,
+    rows: &mut Vec<Row>,
+) {
+    let mut ss = Supersampled::default();
+    for samples in SAMPLE_COUNTS {
+        let mut pixels = 0u64;
+        let ns = median_ns(config.repeats, || {
+            pixels = 0;
+            for &t in tris {
+                supersample(t, target, samples, &mut ss);
+                pixels += ss.counts.iter().filter(|&&c| c > 0).count() as u64;
+            }
+        });
+        let (mut sum, mut n, mut max) = (0.0, 0u64, 0.0f64);
+        for &t in tris {
+            let Some(exact) = snapped(t) else { continue };
+            supersample(t, target, samples, &mut ss);
+            pixel_areas(exact, target, |x, y, a| {
+                let e = (ss.coverage(x, y) - a.min(1.0)).abs();
+                sum += e;
+                max = max.max(e);
+                n += 1;
+            });
+        }
+        rows.push(Row {
+            family: Family::AntiAliasing,
+            variant: aa_name(samples),
+            workload,
+            target,
+            triangles: tris.len() as u64,
+            pixels,
+            median_ns: ns,
+            errors: Errors {
+                aa_mean: Some(if n == 0 { 0.0 } else { sum / n as f64 }),
+                aa_max: Some(max),
+                ..Errors::default()
+            },
+        });
+    }
+}
+
+/// Texture coordinates per pixel (NaN where nothing was drawn).
+#[derive(Default)]
+struct UvTarget(Vec<[f32; 2]>);
+
+impl ColorTarget for UvTarget {
+    #[inline(always)]
+    fn put(&mut self, i: usize, c: Vec3) {
+        self.0[i] = [c.x, c.y];
+    }
+    fn reset(&mut self, len: usize, _: Vec3) {
+        self.0.clear();
+        self.0.resize(len, [f32::NAN; 2]);
+    }
+}
+
+/// The exact uv at a pixel centre and its step to the neighbouring pixels.
+type ExactUv = ([f64; 2], f64);
+
+/// The interpolation rows of one 3D scene.
+fn interpolation_rows(scene: &Scene3, target: Target, config: &Config, rows: &mut Vec<Row>) {
+    let shader = UvShader {
+        scene,
+        mvp: scene.view_proj(target),
+    };
+    let mut renderer = Renderer::new(target);
+    let mut cache = VertexCache::<Vec2>::default();
+    let mut out = UvTarget::default();
+    // The exact uv at every pixel centre, and how far the uv moves to the next pixel
+    // (the attribute's screen footprint), for errors in pixels.
+    let exact: Option<Vec<Option<ExactUv>>> = scene.plane.map(|_| {
+        let cast = scene.ray_caster(target);
+        let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs().max((a[1] - b[1]).abs());
+        (0..target.height)
+            .flat_map(|y| (0..target.width).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let uv = cast(x, y)?;
+                let step = [cast(x + 1, y), cast(x, y + 1)]
+                    .into_iter()
+                    .flatten()
+                    .map(|n| dist(uv, n))
+                    .fold(0.0, f64::max);
+                Some((uv, step))
+            })
+            .collect()
+    });
+    for mode in Interpolation::ALL {
+        let opts = DrawOptions {
+            interpolation: mode,
+            ..DrawOptions::default()
+        };
+        let mut draw = |out: &mut UvTarget| {
+            renderer.begin_frame(target, out, Vec3::ZERO);
+            transform(&shader, scene.positions.len(), &mut cache);
+            renderer.draw(&shader, &cache, &scene.indices, &opts, out);
+        };
+        let ns = median_ns(config.repeats, || draw(&mut out));
+        draw(&mut out);
+        let stats = renderer.stats;
+        let errors = exact.as_ref().map_or(Errors::default(), |exact| {
+            let mut e = [(0.0, 0.0f64); 2];
+            let mut n = 0u64;
+            for (got, want) in out.0.iter().zip(exact) {
+                let (Some((want, step)), false) = (want, got[0].is_nan()) else {
+                    continue;
+                };
+                let err = (f64::from(got[0]) - want[0])
+                    .abs()
+                    .max((f64::from(got[1]) - want[1]).abs());
+                let px = err / step.max(f64::MIN_POSITIVE);
+                for (acc, v) in e.iter_mut().zip([err, px]) {
+                    acc.0 += v;
+                    acc.1 = acc.1.max(v);
+                }
+                n += 1;
+            }
+            let mean = |s: f64| if n == 0 { 0.0 } else { s / n as f64 };
+            Errors {
+                attr_max: Some(e[0].1),
+                attr_mean: Some(mean(e[0].0)),
+                attr_max_px: Some(e[1].1),
+                attr_mean_px: Some(mean(e[1].0)),
+                ..Errors::default()
+            }
+        });
+        rows.push(Row {
+            family: Family::Interpolation,
+            variant: mode.name(),
+            workload: scene.name,
+            target,
+            triangles: stats.drawn,
+            pixels: stats.shaded,
+            median_ns: ns,
+            errors,
+        });
+    }
+}
+
+/// Two parallel planes tilted in depth, `gap` apart at view distance `distance`,
+/// filling the view: (farther, nearer) as positions with two triangles each.
+fn close_planes(distance: f32, gap: f32) -> [Vec<Vec3>; 2] {
+    let cam = crate::camera::Camera::default();
+    let half = distance * (cam.fov_y * 0.5).tan() * 2.0;
+    let tilt = Mat4::from_rotation_x(-0.9);
+    let centre = cam.eye - Vec3::Z * distance;
+    let quad = |offset: f32| {
+        [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .map(|(x, y)| {
+                centre
+                    + tilt.transform_vector3(Vec3::new(x * half, y * half, 0.0))
+                    + tilt.transform_vector3(Vec3::Z) * offset
+            })
+            .to_vec()
+    };
+    [quad(0.0), quad(gap)]
+}
+
+/// View distances and relative gaps of the close-planes workload.
+pub const CLOSE_PLANE_DISTANCES: [f32; 4] = [0.3, 1.0, 3.0, 9.0];
+/// Gaps between the planes as fractions of their distance.
+pub const CLOSE_PLANE_GAPS: [f32; 3] = [1e-3, 1e-4, 1e-5];
+
+/// The depth rows: z-fighting on close planes, and the bunny for speed.
+fn depth_rows(target: Target, config: &Config, rows: &mut Vec<Row>) {
+    const QUAD: [u32; 6] = [0, 1, 2, 0, 2, 3];
+    let cam = crate::camera::Camera::default();
+    let vp = cam.projection(target.width, target.height, 1.0) * cam.view();
+    let bunny = workloads::bunny_scene();
+    for format in DepthFormat::ALL {
+        let matrix = format.projection(vp);
+        let mut pass = DepthPass::new(target, format);
+        let (mut wrong, mut total, mut fragments) = (0u64, 0u64, 0u64);
+        let mut ns = 0.0;
+        let mut triangles = 0;
+        for d in CLOSE_PLANE_DISTANCES {
+            for g in CLOSE_PLANE_GAPS {
+                let [far, near] = close_planes(d, d * g);
+                for near_first in [false, true] {
+                    let order: [(&[Vec3], u32); 2] = if near_first {
+                        [(&near, 1), (&far, 0)]
+                    } else {
+                        [(&far, 0), (&near, 1)]
+                    };
+                    ns += median_ns(config.repeats, || {
+                        pass.clear();
+                        for (p, id) in order {
+                            pass.draw(p, &QUAD, matrix, id);
+                        }
+                    });
+                    triangles += 4;
+                    fragments += pass.fragments;
+                    // Pixels both planes cover: the ids show which won.
+                    total += pass.ids.iter().filter(|&&i| i != u32::MAX).count() as u64;
+                    wrong += pass.ids.iter().filter(|&&i| i == 0).count() as u64;
+                }
+            }
+        }
+        rows.push(Row {
+            family: Family::Depth,
+            variant: format.name(),
+            workload: "close-planes",
+            target,
+            triangles,
+            pixels: fragments,
+            median_ns: ns,
+            errors: Errors {
+                zfight: Some(if total == 0 {
+                    0.0
+                } else {
+                    wrong as f64 / total as f64
+                }),
+                ..Errors::default()
+            },
+        });
+        let matrix = format.projection(bunny.view_proj(target));
+        let ns = median_ns(config.repeats, || {
+            pass.clear();
+            pass.draw(&bunny.positions, &bunny.indices, matrix, 0);
+        });
+        rows.push(Row {
+            family: Family::Depth,
+            variant: format.name(),
+            workload: "bunny",
+            target,
+            triangles: (bunny.indices.len() / 3) as u64,
+            pixels: pass.fragments,
+            median_ns: ns,
+            errors: Errors::default(),
+        });
+    }
+}
+
+/// Runs every variant on every workload at every size. `progress` is told what is
+/// being measured.
+pub fn run(config: &Config, mut progress: impl FnMut(&str)) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for &target in &config.sizes {
+        for &name in &WORKLOADS {
+            progress(&format!("{}x{} {name}", target.width, target.height));
+            let tris = workloads::triangles(name, target, config.scale);
+            coverage_rows(name, &tris, target, config, &mut rows);
+            aa_rows(name, &tris, target, config, &mut rows);
+            if let Some(scene) = workloads::scene(name) {
+                interpolation_rows(&scene, target, config, &mut rows);
+            }
+        }
+        progress(&format!("{}x{} depth", target.width, target.height));
+        depth_rows(target, config, &mut rows);
+    }
+    rows
+}

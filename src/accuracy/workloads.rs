@@ -80,7 +80,10 @@ impl Scene3 {
 }
 
 /// A plane `y = height` between two corners, as a grid of `nx × nz` quads, with uv =
-/// (x, z) / `uv_scale`, turned by `turn` radians about y (so depth varies along rows).
+/// (x, z) / `uv_scale`, banked by `roll` radians about z, then turned by `turn` about
+/// y. (A level plane seen by a level camera has constant depth along each screen row,
+/// so only a banked one makes depth vary along rows.)
+#[allow(clippy::too_many_arguments)]
 fn plane_grid(
     name: &'static str,
     (x0, x1): (f32, f32),
@@ -88,9 +91,10 @@ fn plane_grid(
     height: f32,
     (nx, nz): (u32, u32),
     uv_scale: f32,
+    roll: f32,
     turn: f32,
 ) -> Scene3 {
-    let rot = Mat4::from_rotation_y(turn);
+    let rot = Mat4::from_rotation_y(turn) * Mat4::from_rotation_z(roll);
     let mut positions = Vec::new();
     let mut uvs = Vec::new();
     for j in 0..=nz {
@@ -109,7 +113,7 @@ fn plane_grid(
             indices.extend([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
         }
     }
-    let rot_d = DMat4::from_rotation_y(f64::from(turn));
+    let rot_d = DMat4::from_rotation_y(f64::from(turn)) * DMat4::from_rotation_z(f64::from(roll));
     let to_uv = DMat4::from_cols(
         DVec4::new(1.0, 0.0, 0.0, 0.0),
         DVec4::ZERO,
@@ -142,15 +146,26 @@ pub fn near_plane_scene() -> Scene3 {
         -0.5,
         (8, 12),
         2.0,
+        0.0,
         0.3,
     )
 }
 
-/// A long thin floor strip (1 wide, 80 deep) seen at a grazing angle and turned, so
-/// perspective is strong along and across rows.
+/// A long floor (4 wide, 80 deep, 64 long thin quads) seen at a grazing angle,
+/// banked 0.5 rad and turned 0.4 rad so depth changes fast along screen rows: where
+/// interpolation shortcuts show.
 #[must_use]
 pub fn floor_scene() -> Scene3 {
-    plane_grid("floor", (-0.5, 0.5), (2.0, -78.0), -0.6, (1, 64), 0.25, 0.5)
+    plane_grid(
+        "floor",
+        (-2.0, 2.0),
+        (2.0, -78.0),
+        -0.6,
+        (1, 64),
+        0.25,
+        0.5,
+        0.4,
+    )
 }
 
 /// The bunny with the standard camera (no texture coordinates: uv = (x, y)).

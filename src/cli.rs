@@ -72,6 +72,8 @@ pub enum CliError {
     #[error(transparent)]
     View(#[from] crate::tui::ViewError),
     #[error(transparent)]
+    Scene(#[from] crate::scene::SceneError),
+    #[error(transparent)]
     Io(#[from] io::Error),
 }
 

@@ -6,9 +6,11 @@
 pub mod accuracy;
 pub mod camera;
 pub mod cli;
+pub mod counters;
 pub mod mesh;
 pub mod raster;
 pub mod render;
+pub mod scene;
 pub mod terminal;
 pub mod tui;
 pub mod workload;

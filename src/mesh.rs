@@ -22,7 +22,7 @@ const BUNNY_OBJ: &str = include_str!("mesh/bunny.obj");
 pub const MAX_SPHERE_TRIANGLES: usize = 1 << 22;
 
 /// An indexed triangle mesh. Optional attributes are empty when absent.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Mesh {
     /// Where the mesh came from, for messages and the status line.
     pub name: String,
@@ -35,6 +35,9 @@ pub struct Mesh {
     pub colors: Vec<Vec3>,
     /// Three indices per triangle.
     pub indices: Vec<u32>,
+    /// The diffuse texture (`map_Kd`) of the first material that has one, resolved
+    /// relative to the OBJ file, or why the material library could not be read.
+    pub texture: Result<Option<PathBuf>, String>,
 }
 
 /// Why a mesh could not be loaded.
@@ -57,6 +60,20 @@ pub enum MeshError {
         "unknown built-in model `{0}` (try `teapot`, `bunny`, `sphere:N` with N from 1 to 4194304, or an OBJ path)"
     )]
     UnknownBuiltin(String),
+}
+
+impl Default for Mesh {
+    fn default() -> Self {
+        Self {
+            name: String::new(),
+            positions: Vec::new(),
+            normals: Vec::new(),
+            uvs: Vec::new(),
+            colors: Vec::new(),
+            indices: Vec::new(),
+            texture: Ok(None),
+        }
+    }
 }
 
 impl Mesh {
@@ -181,6 +198,10 @@ impl Mesh {
         if self.normals.len() == self.positions.len() {
             return;
         }
+        crate::counters::add(
+            crate::counters::Stage::NormalsGenerated,
+            self.positions.len() as u64,
+        );
         let mut n = vec![Vec3::ZERO; self.positions.len()];
         for t in self.indices.chunks_exact(3) {
             let [a, b, c] = [t[0], t[1], t[2]].map(|i| self.positions[i as usize]);
@@ -217,18 +238,34 @@ fn parse_obj(text: &str, path: &Path) -> Result<Mesh, MeshError> {
         ..Default::default()
     };
     let mut reader = BufReader::new(text.as_bytes());
-    let (models, _materials) =
-        tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed)).map_err(
-            |e| {
-                let (line, problem) = locate_error(text, e);
-                MeshError::Malformed {
-                    path: path.into(),
-                    line,
-                    problem,
-                }
-            },
-        )?;
-    let mut m = Mesh::default();
+    // Material libraries are read relative to the OBJ file (embedded models have none).
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mtl_problem = std::cell::RefCell::new(None);
+    let (models, materials) = tobj::load_obj_buf(&mut reader, &opts, |p| {
+        let file = dir.join(p);
+        tobj::load_mtl(&file).inspect_err(|e| {
+            *mtl_problem.borrow_mut() = Some(format!("{}: {e}", file.display()));
+        })
+    })
+    .map_err(|e| {
+        let (line, problem) = locate_error(text, e);
+        MeshError::Malformed {
+            path: path.into(),
+            line,
+            problem,
+        }
+    })?;
+    let mut m = Mesh {
+        texture: match (mtl_problem.into_inner(), materials) {
+            (Some(p), _) => Err(p),
+            (None, Err(e)) => Err(format!("material library: {e}")),
+            (None, Ok(mats)) => Ok(mats
+                .iter()
+                .find_map(|mt| mt.diffuse_texture.as_deref())
+                .map(|t| dir.join(t.trim()))),
+        },
+        ..Mesh::default()
+    };
     for model in models {
         let mm = model.mesh;
         let base = m.positions.len() as u32;

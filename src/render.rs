@@ -16,6 +16,7 @@ pub mod wire;
 
 use glam::{Vec3, Vec4};
 
+use crate::counters::{self, Stage};
 use crate::raster::clip::{ClipOutcome, ClipVertex, classify, clip_triangle, guard_band_ndc};
 use crate::raster::depth::{DepthBuffer, DepthFunc, DepthState};
 use crate::raster::interp::{
@@ -446,12 +447,15 @@ impl<S: Shader, C: ColorTarget> CoverageSink for Fragments<'_, S, C> {
         let e = self.tri.eval(x, y);
         let i = y as usize * self.width + x as usize;
         self.fragments += 1;
-        let old = self.depth.data[i];
-        if !self.opts.depth.func.passes(e.depth, old) {
-            return;
-        }
-        if self.opts.depth.write {
-            self.depth.data[i] = e.depth;
+        if self.opts.depth.uses_buffer() {
+            counters::add(Stage::DepthTests, 1);
+            let old = self.depth.data[i];
+            if !self.opts.depth.func.passes(e.depth, old) {
+                return;
+            }
+            if self.opts.depth.write {
+                self.depth.data[i] = e.depth;
+            }
         }
         let v = self.tri.varyings(&e, self.opts.interpolation);
         self.color.put(i, self.shader.fragment(&v));
@@ -510,24 +514,30 @@ impl<S: Shader, C: ColorTarget> Fragments<'_, S, C> {
         let b = [fl[1] * ia, fl[2] * ia, fl[0] * ia];
         let z = map3(t.z, f32x8::splat);
         let depth = b[0] * z[0] + b[1] * z[1] + b[2] * z[2];
-        let slot: &mut [f32; 8] = (&mut self.depth.data[start..start + 8])
-            .try_into()
-            .expect("8 lanes");
-        let old = f32x8::new(*slot);
-        let test = match self.opts.depth.func {
-            DepthFunc::Less => depth.simd_lt(old).to_bitmask() as u8,
-            DepthFunc::LessEqual => depth.simd_le(old).to_bitmask() as u8,
-            DepthFunc::Always => !0,
-        };
-        let pass = test & mask;
         self.fragments += u64::from(mask.count_ones());
+        let pass = if self.opts.depth.uses_buffer() {
+            counters::add(Stage::DepthTests, u64::from(mask.count_ones()));
+            let slot: &mut [f32; 8] = (&mut self.depth.data[start..start + 8])
+                .try_into()
+                .expect("8 lanes");
+            let old = f32x8::new(*slot);
+            let test = match self.opts.depth.func {
+                DepthFunc::Less => depth.simd_lt(old).to_bitmask() as u8,
+                DepthFunc::LessEqual => depth.simd_le(old).to_bitmask() as u8,
+                DepthFunc::Always => !0,
+            };
+            let pass = test & mask;
+            if pass != 0 && self.opts.depth.write {
+                *slot = bytemuck::cast::<_, f32x8>(lanes_of(pass))
+                    .select(depth, old)
+                    .to_array();
+            }
+            pass
+        } else {
+            mask
+        };
         if pass == 0 {
             return;
-        }
-        if self.opts.depth.write {
-            *slot = bytemuck::cast::<_, f32x8>(lanes_of(pass))
-                .select(depth, old)
-                .to_array();
         }
         let w = match self.opts.interpolation {
             Interpolation::Perspective => {
@@ -641,10 +651,38 @@ impl Renderer {
     /// Starts a frame: clears depth and colour (reallocating only on resize) and the
     /// counters.
     pub fn begin_frame<C: ColorTarget>(&mut self, target: Target, color: &mut C, background: Vec3) {
+        self.begin_frame_with(target, color, background, true);
+    }
+
+    /// Starts a frame with or without a depth buffer. Without one, the buffer's memory
+    /// is released and nothing is cleared: draws must not use it (a draw that does
+    /// gets a fresh one).
+    pub fn begin_frame_with<C: ColorTarget>(
+        &mut self,
+        target: Target,
+        color: &mut C,
+        background: Vec3,
+        depth: bool,
+    ) {
         self.target = target;
-        self.depth.reset(target.width, target.height);
+        if depth {
+            self.depth.reset(target.width, target.height);
+            counters::add(Stage::DepthClears, target.len() as u64);
+        } else {
+            self.depth = DepthBuffer {
+                width: target.width,
+                height: target.height,
+                data: Vec::new(),
+            };
+        }
         color.reset(target.len(), background);
         self.stats = DrawStats::default();
+    }
+
+    /// Whether this frame has a depth buffer.
+    #[must_use]
+    pub fn has_depth(&self) -> bool {
+        self.depth.data.len() == self.target.len()
     }
 
     /// Draws indexed triangles whose vertices are already in `cache` (see [`transform`]).
@@ -656,6 +694,9 @@ impl Renderer {
         opts: &DrawOptions,
         color: &mut C,
     ) {
+        if opts.depth.uses_buffer() && !self.has_depth() {
+            self.depth.reset(self.target.width, self.target.height);
+        }
         #[cfg(target_arch = "x86_64")]
         if self.isa == Isa::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2, checked just above.

@@ -2,7 +2,7 @@
 //! benchmark scene).
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
@@ -13,11 +13,14 @@ use crate::raster::{Target, Traversal};
 use crate::render::standard::{Model, RADIANS_PER_FRAME, StandardFrame, StandardView};
 use crate::render::wire::Mode;
 use crate::render::{Cull, DrawOptions, Rgba8};
+use crate::scene::render::{SceneFrame, SceneView};
+use crate::scene::{Scene, is_scene_path};
 
 /// Options shared by the 3D commands.
 #[derive(Debug, Args)]
 pub struct SceneArgs {
-    /// `teapot` or `bunny` (built in), `sphere:N` (UV sphere of about N triangles) or an OBJ path.
+    /// `teapot` or `bunny` (built in), `sphere:N` (UV sphere of about N triangles), an
+    /// OBJ path, or (for `render`) a scene file `SCENE.toml`.
     #[arg(default_value = "teapot")]
     pub model: String,
     /// Skip back faces.
@@ -81,6 +84,10 @@ pub struct PngArgs {
     /// Glyphs and colours of text frames.
     #[command(flatten)]
     pub look: super::view_cmd::LookArgs,
+    /// Print the scene's plan (what runs and what is skipped, and why) and exit.
+    /// A model is shorthand for its default scene.
+    #[arg(long)]
+    pub plan: bool,
 }
 
 /// Arguments of `termrast bench render`.
@@ -101,6 +108,20 @@ pub struct BenchRenderArgs {
 
 /// Writes frames of the standard scene as ANSI text, or one as a PNG with `--out`.
 pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
+    if args.plan {
+        let scene = if is_scene_path(&args.scene.model) {
+            Scene::load(Path::new(&args.scene.model))?
+        } else {
+            Scene::for_model(&args.scene.model)?
+        };
+        let mut out = std::io::stdout().lock();
+        writeln!(out, "plan of {}", scene.source)?;
+        write!(out, "{}", scene.plan)?;
+        return Ok(());
+    }
+    if is_scene_path(&args.scene.model) {
+        return scene_frames(args);
+    }
     let model = args.scene.model()?;
     let Some(out_path) = &args.out else {
         let mut settings = args.look.settings(args.scene.mode, args.scene.cull);
@@ -147,6 +168,54 @@ pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
     )
     .map_err(|e| super::CliError::Image(out_path.clone(), e))?;
     Ok(())
+}
+
+/// Seconds of scene time between text frames.
+pub const SCENE_SECONDS_PER_FRAME: f32 = 0.1;
+
+/// `termrast render SCENE.toml`: text frames, or one PNG with `--out`.
+fn scene_frames(args: &PngArgs) -> Result<(), super::CliError> {
+    let scene = Scene::load(Path::new(&args.scene.model))?;
+    let mut frame = SceneFrame::new(&scene);
+    if let Some(out_path) = &args.out {
+        let target = args.size;
+        frame.draw(&scene, target, &SceneView::default());
+        return write_png(out_path, &frame.color, target);
+    }
+    let mut settings = args.look.settings(Mode::Fill, false);
+    settings.angle = 0.0;
+    settings.tilt = 0.0;
+    let mut vp = crate::tui::viewport::Viewport::default();
+    let mut out = std::io::stdout().lock();
+    for n in 0..args.frames {
+        let t = n as f32 * SCENE_SECONDS_PER_FRAME;
+        vp.render_scene(&scene, &mut frame, &settings, (args.cols, args.rows), t);
+        if args.animate {
+            out.write_all(b"\x1b[H")?;
+        } else if n > 0 {
+            out.write_all(b"\n")?;
+        }
+        super::view_cmd::write_ansi(&vp, &mut out)?;
+    }
+    out.flush()?;
+    Ok(())
+}
+
+/// Writes an opaque PNG (the uncovered background, alpha 0 in the target, is black).
+fn write_png(path: &Path, color: &Rgba8, target: Target) -> Result<(), super::CliError> {
+    let bytes: Vec<u8> = color
+        .0
+        .iter()
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    image::save_buffer(
+        path,
+        &bytes,
+        target.width,
+        target.height,
+        image::ExtendedColorType::Rgba8,
+    )
+    .map_err(|e| super::CliError::Image(path.into(), e))
 }
 
 /// The result of the standard benchmark.

@@ -54,7 +54,8 @@ impl LookArgs {
 /// Arguments of the viewer.
 #[derive(Debug, Args, Clone)]
 pub struct ViewArgs {
-    /// `teapot` or `bunny` (built in), `sphere:N` or an OBJ path.
+    /// `teapot` or `bunny` (built in), `sphere:N`, an OBJ path, or a scene file
+    /// `SCENE.toml`.
     #[arg(default_value = "teapot")]
     pub model: String,
     #[command(flatten)]
@@ -79,6 +80,14 @@ pub fn load_model(spec: &str) -> Result<Model, crate::mesh::MeshError> {
 
 /// Runs the viewer.
 pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
+    if crate::scene::is_scene_path(&args.model) {
+        let scene = crate::scene::Scene::load(std::path::Path::new(&args.model))?;
+        crate::tui::run(
+            App::with_scene(scene, args.look.settings(args.mode, args.cull)),
+            args.fps,
+        )?;
+        return Ok(());
+    }
     let model = load_model(&args.model)?;
     crate::tui::run(
         App::new(model, args.look.settings(args.mode, args.cull)),

@@ -50,6 +50,22 @@ pub struct DepthState {
     pub write: bool,
 }
 
+impl DepthState {
+    /// No test and no write: the draw never touches the depth buffer (and a frame
+    /// whose draws are all like this needs none).
+    pub const OFF: DepthState = DepthState {
+        func: DepthFunc::Always,
+        write: false,
+    };
+
+    /// Whether a draw with this state reads or writes the depth buffer.
+    #[must_use]
+    #[inline(always)]
+    pub fn uses_buffer(self) -> bool {
+        self != Self::OFF
+    }
+}
+
 impl Default for DepthState {
     fn default() -> Self {
         Self {

@@ -62,18 +62,33 @@ pub fn probe<V: Varying>(
     x: u32,
     y: u32,
 ) -> Probe<V> {
+    probe_from(cache, indices, target, opts, x, y, DEPTH_CLEAR)
+}
+
+/// [`probe`] for a draw that starts with `stored` in the depth buffer at the pixel
+/// (the depth left by earlier draws of the frame).
+#[must_use]
+pub fn probe_from<V: Varying>(
+    cache: &VertexCache<V>,
+    indices: &[u32],
+    target: Target,
+    opts: &DrawOptions,
+    x: u32,
+    y: u32,
+    stored: f32,
+) -> Probe<V> {
     let (depth_state, interpolation) = (opts.depth, opts.interpolation);
     let mut out = Probe {
         x,
         y,
         records: Vec::new(),
         winner: None,
-        final_depth: DEPTH_CLEAR,
+        final_depth: stored,
     };
     if x >= target.width || y >= target.height {
         return out;
     }
-    let mut stored = DEPTH_CLEAR;
+    let mut stored = stored;
     for t in 0..(indices.len() / 3) as u32 {
         let _ = prepare(cache, indices, t, target, opts.cull, &mut |p: &Prepared<
             V,

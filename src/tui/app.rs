@@ -12,10 +12,12 @@ use ratatui::style::{Modifier, Style};
 use ratatui::text::Line;
 use ratatui::widgets::{Block, Borders, Clear, Paragraph, Wrap};
 
-use super::inspector::{inspector_text, line_at, line_text, sample_pixel};
+use super::inspector::{inspector_text, line_at, line_text, sample_pixel, scene_inspector_text};
 use super::viewport::{ViewSettings, Viewport};
 use crate::render::standard::Model;
 use crate::render::wire::{Mode, project_edge};
+use crate::scene::Scene;
+use crate::scene::render::SceneFrame;
 use crate::terminal::{ColorMode, GlyphMode};
 
 /// Smallest usable terminal.
@@ -51,6 +53,19 @@ pub struct App {
     drag: Option<(u16, u16)>,
     /// Area of the viewport on screen, from the last draw.
     view_area: Rect,
+    /// A scene shown instead of the model, with its buffers and clock.
+    pub scene: Option<SceneState>,
+    /// Show the scene's plan.
+    pub show_plan: bool,
+}
+
+/// A scene in the viewer: what it is, its pipelines and buffers, and its time.
+#[derive(Debug)]
+pub struct SceneState {
+    pub scene: Scene,
+    pub frame: SceneFrame,
+    /// Seconds of animation (stops while paused).
+    pub time: f32,
 }
 
 impl App {
@@ -74,11 +89,35 @@ impl App {
             status: String::with_capacity(256),
             drag: None,
             view_area: Rect::default(),
+            scene: None,
+            show_plan: false,
         }
+    }
+
+    /// A viewer for a scene: its objects spin as the file says, and the arrows and
+    /// mouse orbit the camera about its target.
+    #[must_use]
+    pub fn with_scene(scene: Scene, settings: ViewSettings) -> Self {
+        let frame = SceneFrame::new(&scene);
+        let mut app = Self::new(Model::new(crate::mesh::Mesh::default()), settings);
+        app.settings.angle = 0.0;
+        app.settings.tilt = 0.0;
+        app.scene = Some(SceneState {
+            scene,
+            frame,
+            time: 0.0,
+        });
+        app
     }
 
     /// Advances the animation by `dt`.
     pub fn tick(&mut self, dt: Duration) {
+        if let Some(s) = &mut self.scene {
+            if !self.paused {
+                s.time += dt.as_secs_f32();
+            }
+            return;
+        }
         if !self.paused {
             self.settings.angle =
                 (self.settings.angle + SPIN * dt.as_secs_f32()) % std::f32::consts::TAU;
@@ -164,13 +203,15 @@ impl App {
         match k.code {
             KeyCode::Char('c') if ctrl => self.quit = true,
             KeyCode::Char('q') | KeyCode::Esc => {
-                if self.help {
+                if self.help || self.show_plan {
                     self.help = false;
+                    self.show_plan = false;
                 } else {
                     self.quit = true;
                 }
             }
             KeyCode::Char('?') => self.help = !self.help,
+            KeyCode::Char('p') if self.scene.is_some() => self.show_plan = !self.show_plan,
             KeyCode::Char(' ') => self.paused = !self.paused,
             KeyCode::Char('i') => self.inspect = !self.inspect,
             KeyCode::Char('w') => self.settings.mode = Self::cycle(&Mode::ALL, self.settings.mode),
@@ -231,8 +272,18 @@ impl App {
             [main, Rect::default()]
         };
         self.view_area = view;
-        self.viewport
-            .render(&self.model, &self.settings, view.width, view.height);
+        match &mut self.scene {
+            Some(s) => self.viewport.render_scene(
+                &s.scene,
+                &mut s.frame,
+                &self.settings,
+                (view.width, view.height),
+                s.time,
+            ),
+            None => self
+                .viewport
+                .render(&self.model, &self.settings, view.width, view.height),
+        }
         self.cursor = (
             self.cursor.0.min(view.width - 1),
             self.cursor.1.min(view.height - 1),
@@ -251,11 +302,42 @@ impl App {
         f.render_widget(Paragraph::new(Line::from(self.status.as_str())), status);
         if self.help {
             self.draw_help(f, main);
+        } else if self.show_plan {
+            self.draw_plan(f, main);
         }
+    }
+
+    fn draw_plan(&self, f: &mut Frame, area: Rect) {
+        let Some(s) = &self.scene else { return };
+        let text = s.scene.plan.to_string();
+        let w = 76.min(area.width);
+        let h = (text.lines().count() as u16 + 2).min(area.height);
+        let r = Rect::new(area.x + (area.width - w) / 2, area.y, w, h);
+        f.render_widget(Clear, r);
+        f.render_widget(
+            Paragraph::new(text).block(
+                Block::default()
+                    .borders(Borders::ALL)
+                    .title(" plan (p closes) "),
+            ),
+            r,
+        );
     }
 
     fn draw_panel(&self, f: &mut Frame, area: Rect) {
         let (cx, cy) = self.cursor;
+        if let Some(s) = &self.scene {
+            let text = scene_inspector_text(&self.viewport, s, cx, cy, self.sub);
+            f.render_widget(
+                Paragraph::new(text).wrap(Wrap { trim: false }).block(
+                    Block::default()
+                        .borders(Borders::ALL)
+                        .title(" inspector (Tab: sample, p: plan) "),
+                ),
+                area,
+            );
+            return;
+        }
         let text = inspector_text(&self.viewport, &self.model, cx, cy, self.sub);
         let (x, y) = sample_pixel(&self.viewport, cx, cy, self.sub);
         let line = match self.line_focus {
@@ -294,7 +376,10 @@ impl App {
     /// Rewrites the status line (into a buffer kept across frames): state, speed,
     /// time split, triangle counts, bytes written.
     pub fn update_status(&mut self) {
-        let s = self.viewport.frame.renderer.stats;
+        let s = match &self.scene {
+            Some(sc) => sc.frame.stats,
+            None => self.viewport.frame.renderer.stats,
+        };
         let [tf, rs] = self.viewport.frame.timing;
         let ms = |d: Duration| d.as_secs_f64() * 1e3;
         let mode = match self.settings.mode {
@@ -322,6 +407,9 @@ impl App {
             s.clipped,
             self.bytes,
         );
+        if let Some(sc) = &self.scene {
+            let _ = write!(self.status, " | plan: {} (p)", sc.scene.plan.summary());
+        }
     }
 
     fn draw_help(&self, f: &mut Frame, area: Rect) {
@@ -336,9 +424,10 @@ impl App {
                     Tab       next sub-sample of the cell\n\
                     [ ]       step along the line in the line panel\n\
                     drag      rotate\n\
+                    p         the scene's plan (scenes only)\n\
                     ?         this help        q / Esc / Ctrl-C  quit";
         let w = 72.min(area.width);
-        let h = 14.min(area.height);
+        let h = 15.min(area.height);
         let r = Rect::new(
             area.x + (area.width - w) / 2,
             area.y + (area.height - h) / 2,

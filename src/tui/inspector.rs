@@ -4,14 +4,16 @@
 
 use std::fmt::Write as _;
 
+use crate::accuracy::area::grid_side;
 use crate::raster::line::Move;
-use crate::raster::probe::{DepthOutcome, probe};
+use crate::raster::probe::{DepthOutcome, Probe, probe};
 use crate::render::Shader;
 use crate::render::standard::{Model, StandardFrame};
 use crate::render::target::luminance;
 use crate::render::wire::{ScreenLine, probe_lines, project_edge};
 use crate::terminal::glyphs::explain;
 
+use super::app::SceneState;
 use super::viewport::Viewport;
 
 /// The sample pixel of sub-sample `sub` of cell `(cx, cy)`.
@@ -81,6 +83,13 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
     let (x, y) = sample_pixel(vp, cx, cy, sub);
     let Some(p) = selected else { return t };
     let _ = writeln!(t, "sample ({x},{y}), overdraw in draw order:");
+    overdraw_text(&mut t, &p, opts.depth.uses_buffer());
+    t
+}
+
+/// The overdraw list of a probe: every triangle whose box holds the pixel, in draw
+/// order, with its edge values, barycentrics, depth and depth test.
+fn overdraw_text<V>(t: &mut String, p: &Probe<V>, depth_test: bool) {
     if p.records.is_empty() {
         let _ = writeln!(t, "  no triangle's box holds this sample");
     }
@@ -89,6 +98,7 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
         let e = &r.eval;
         let test = match r.depth {
             DepthOutcome::NotCovered => "not covered".to_string(),
+            DepthOutcome::Passed { .. } if !depth_test => "drawn (no depth test)".to_string(),
             DepthOutcome::Passed { against } => format!("passed {:.5} < {:.5}", e.depth, against),
             DepthOutcome::Failed { against } => format!("failed {:.5} >= {:.5}", e.depth, against),
         };
@@ -117,6 +127,65 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
             e.bary[0], e.bary[1], e.bary[2], e.persp[0], e.persp[1], e.persp[2]
         );
         let _ = writeln!(t, "   1/w {:.5}  depth {:.6}", e.inv_w, e.depth);
+    }
+}
+
+/// The inspector text for a scene: the cell's glyph and samples, then for the
+/// selected sample each object's overdraw list in draw order (depth carried from
+/// object to object), with the object's pipeline.
+#[must_use]
+pub fn scene_inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub: usize) -> String {
+    let mut t = String::new();
+    let Some(g) = vp.cell(cx, cy) else {
+        return "cursor outside the view".into();
+    };
+    let (samples, n) = vp.samples(cx, cy);
+    let _ = writeln!(
+        t,
+        "cell ({cx},{cy})  glyph '{}'  fg {}  bg {}",
+        g.ch,
+        hex(g.fg),
+        hex(g.bg)
+    );
+    let _ = writeln!(t, "  {}", explain(vp.settings.glyphs, &samples[..n], g));
+    for (k, smp) in samples[..n].iter().enumerate() {
+        let mark = if k == sub % n { '>' } else { ' ' };
+        let (x, y) = sample_pixel(vp, cx, cy, k);
+        let _ = writeln!(
+            t,
+            "{mark}s{k} ({x},{y}) {} {}",
+            if smp.covered { "covered" } else { "empty" },
+            hex(Some(smp.rgb))
+        );
+    }
+    let (x, y) = sample_pixel(vp, cx, cy, sub);
+    let side = grid_side(s.scene.plan.samples);
+    let (fx, fy) = (x * side + side / 2, y * side + side / 2);
+    if side > 1 {
+        let _ = writeln!(
+            t,
+            "supersampled: probing sample ({fx},{fy}) of its {side}×{side} grid"
+        );
+    }
+    for ((p, obj), op) in s
+        .frame
+        .probe(&s.scene, fx, fy)
+        .iter()
+        .zip(&s.scene.objects)
+        .zip(&s.scene.plan.objects)
+    {
+        let _ = writeln!(
+            t,
+            "object {} ({}), varyings {}:",
+            obj.desc.name,
+            if op.depth_test {
+                "depth test"
+            } else {
+                "no depth test"
+            },
+            op.varyings
+        );
+        overdraw_text(&mut t, p, op.depth_test);
     }
     t
 }

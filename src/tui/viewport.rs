@@ -12,6 +12,8 @@ use crate::raster::Target;
 use crate::render::standard::{Model, StandardFrame, StandardView};
 use crate::render::wire::Mode;
 use crate::render::{Cull, DrawOptions, Rgba8};
+use crate::scene::Scene;
+use crate::scene::render::{SceneFrame, SceneView};
 use crate::terminal::glyphs::{Sample, fit_cell};
 use crate::terminal::{CellGlyph, ColorMode, GlyphMode};
 
@@ -118,6 +120,78 @@ impl Viewport {
             settings.mode,
             &mut self.color,
         );
+        self.fit_cells();
+    }
+
+    /// Renders a scene (spins at `time` seconds, the camera orbited by the view
+    /// settings' angle and tilt) and fits every cell's glyph; silhouette edges are
+    /// drawn over the cells as `/ \ | _`.
+    pub fn render_scene(
+        &mut self,
+        scene: &Scene,
+        frame: &mut SceneFrame,
+        settings: &ViewSettings,
+        (cols, rows): (u16, u16),
+        time: f32,
+    ) {
+        let (sx, sy) = settings.glyphs.dims();
+        let target = Target::new(u32::from(cols) * sx, u32::from(rows) * sy);
+        self.settings = *settings;
+        self.cols = cols;
+        self.rows = rows;
+        self.target = target;
+        let view = SceneView {
+            time,
+            yaw: settings.angle,
+            pitch: settings.tilt,
+            zoom: settings.zoom,
+            pixel_aspect: settings.cell_aspect * sy as f32 / sx as f32,
+        };
+        let start = Instant::now();
+        frame.draw(scene, target, &view);
+        self.frame.timing = [Duration::ZERO, start.elapsed()];
+        self.wire_pixels = frame.wire_pixels;
+        // The finished frame becomes the viewport's; its old buffer is drawn into next.
+        std::mem::swap(&mut self.color, &mut frame.color);
+        self.fit_cells();
+        for s in &frame.silhouettes {
+            self.overlay_edge(s.a, s.b);
+        }
+    }
+
+    /// Draws a silhouette edge (sample coordinates) over the cells it crosses, with
+    /// the glyph closest to its direction on screen (cells are `cell_aspect` as wide
+    /// as they are tall).
+    fn overlay_edge(&mut self, a: glam::Vec2, b: glam::Vec2) {
+        let (sx, sy) = self.settings.glyphs.dims();
+        let cell = |p: glam::Vec2| {
+            (
+                (p.x / sx as f32).floor() as i64,
+                (p.y / sy as f32).floor() as i64,
+            )
+        };
+        let (ca, cb) = (cell(a), cell(b));
+        let d = b - a;
+        let ch = edge_glyph(d.x / sx as f32 * self.settings.cell_aspect, d.y / sy as f32);
+        let Ok(line) = crate::raster::line::Line::new(ca, cb) else {
+            return;
+        };
+        let (cols, rows) = (i64::from(self.cols), i64::from(self.rows));
+        line.draw_clipped(
+            cols,
+            rows,
+            |x, y| {
+                let g = &mut self.cells[(y * cols + x) as usize];
+                g.ch = ch;
+                g.fg = Some(g.fg.unwrap_or([230, 230, 230]));
+            },
+            &mut crate::raster::line::NoTrace,
+        );
+    }
+
+    /// Fits every cell's glyph and colours to its samples.
+    fn fit_cells(&mut self) {
+        let (cols, rows) = (self.cols, self.rows);
         let start = Instant::now();
         self.cells.clear();
         self.cells
@@ -125,8 +199,11 @@ impl Viewport {
         for cy in 0..rows {
             for cx in 0..cols {
                 let (s, n) = self.samples(cx, cy);
-                self.cells[usize::from(cy) * usize::from(cols) + usize::from(cx)] =
-                    fit_cell(settings.glyphs, &s[..n], settings.colors == ColorMode::None);
+                self.cells[usize::from(cy) * usize::from(cols) + usize::from(cx)] = fit_cell(
+                    self.settings.glyphs,
+                    &s[..n],
+                    self.settings.colors == ColorMode::None,
+                );
             }
         }
         self.glyph_time = start.elapsed();
@@ -143,9 +220,10 @@ impl Viewport {
                 let x = usize::from(cx) * sx as usize + i as usize;
                 let y = usize::from(cy) * sy as usize + j as usize;
                 if let Some(p) = self.color.0.get(y * w + x) {
+                    // Alpha is coverage: 255 or 0, or a fraction after supersampling.
                     out[(j * sx + i) as usize] = Sample {
                         rgb: [p[0], p[1], p[2]],
-                        covered: p[3] == 255,
+                        covered: p[3] >= 128,
                     };
                 }
             }
@@ -177,5 +255,22 @@ impl Widget for &Viewport {
                 }
             }
         }
+    }
+}
+
+/// The glyph closest to an edge's direction, given in cell widths across (`dx`,
+/// already scaled to the cell's aspect) and cell heights down (`dy`).
+#[must_use]
+pub fn edge_glyph(dx: f32, dy: f32) -> char {
+    // Angle above the horizontal, folded to [0°, 180°): y is down on screen.
+    let mut deg = (-dy).atan2(dx).to_degrees();
+    if deg < 0.0 {
+        deg += 180.0;
+    }
+    match deg {
+        d if !(22.5..157.5).contains(&d) => '_',
+        d if d < 67.5 => '/',
+        d if d < 112.5 => '|',
+        _ => '\\',
     }
 }

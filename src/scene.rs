@@ -1,0 +1,504 @@
+//! Scenes: TOML files that declare objects, their materials and effects, lights and
+//! a camera; and a renderer that does only the work those effects call for.
+//!
+//! # The file
+//!
+//! The minimal scene is one `[[object]]` with `model = "teapot"` (or `bunny`,
+//! `sphere:N`, or an OBJ path relative to the scene file). Every other key has a
+//! default and every effect is off: such a scene is the model's silhouette in flat
+//! white, drawn in order without a depth buffer. See `examples/scenes/` for the rest:
+//!
+//! ```toml
+//! [render]                 # antialias = 1 | 4 | 16, background = [r, g, b]
+//! [camera]                 # eye, target, up, fov (degrees), near, far
+//! [[light]]                # kind = "ambient" | "directional" | "point",
+//!                          # color, intensity, direction (towards the light), position
+//! [[object]]
+//! model = "teapot"
+//! position = [0, 0, 0]     # and rotation (degrees about x, y, z), scale
+//! spin = { axis = [0, 1, 0], speed = 0.5 }          # radians per second
+//! [object.material]        # color, lighting = "none" | "flat" | "gouraud" |
+//!                          # "lambert" | "blinn-phong", specular, shininess,
+//!                          # vertex_colors, texture = "off" | "nearest" | "bilinear",
+//!                          # image (a PNG instead of the OBJ material's map_Kd)
+//! [object.effects]         # depth_test, cull, fog = { start, end, color },
+//!                          # depth_shading, wireframe, silhouette
+//! ```
+//!
+//! A lit object in a scene without `[[light]]` gets the standard lights: ambient 0.08
+//! and a directional light towards (0.4, 0.6, 1.0). Point lights fall off as
+//! `1 / (1 + d²)`.
+//!
+//! # The plan
+//!
+//! [`plan::Plan`] decides from the scene alone which attributes are kept and
+//! transformed, which varyings each object interpolates, which buffers exist and
+//! which per-pixel stages run; [`render::SceneFrame`] follows it. Loading already
+//! applies it: attributes no stage reads are dropped from the mesh, normals are only
+//! generated when lighting needs them, edges only computed for wireframes and
+//! silhouettes.
+
+pub mod file;
+pub mod plan;
+pub mod render;
+pub mod texture;
+
+use std::path::{Path, PathBuf};
+
+use glam::{EulerRot, Mat4, Quat, Vec3};
+
+use self::file::{EffectsFile, FogFile, LightKind, Lighting, MaterialFile, TextureMode};
+use self::plan::Plan;
+use self::texture::Texture;
+use crate::camera::Camera;
+use crate::mesh::{Mesh, MeshError};
+use crate::render::wire::unique_edges;
+
+/// Why a scene could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}{}: {problem}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Invalid {
+        path: PathBuf,
+        line: Option<usize>,
+        problem: String,
+    },
+    #[error("{scene}: object {object}: {source}")]
+    Model {
+        scene: PathBuf,
+        object: usize,
+        source: MeshError,
+    },
+    #[error("{scene}: object {object} ({model}): {problem}")]
+    Unsupported {
+        scene: PathBuf,
+        object: usize,
+        model: String,
+        problem: String,
+    },
+    #[error("texture {path}: {problem}")]
+    Texture { path: PathBuf, problem: String },
+}
+
+/// A light, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightDesc {
+    pub kind: LightKind,
+    /// Colour times intensity.
+    pub color: Vec3,
+    /// Directional: unit vector towards the light. Point: its position.
+    pub vector: Vec3,
+}
+
+/// An object as the scene file describes it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectDesc {
+    /// The model as the scene file names it.
+    pub name: String,
+    /// The model spec as resolved (built-in name or path).
+    pub model: String,
+    pub position: Vec3,
+    pub rotation: Quat,
+    pub scale: f32,
+    /// Unit axis and radians per second.
+    pub spin: Option<(Vec3, f32)>,
+    pub material: Material,
+    pub effects: Effects,
+}
+
+impl ObjectDesc {
+    /// Model matrix at time `t` seconds: scale, rotate, spin, translate.
+    #[must_use]
+    pub fn model_matrix(&self, t: f32) -> Mat4 {
+        let spin = self.spin.map_or(Quat::IDENTITY, |(axis, speed)| {
+            Quat::from_axis_angle(axis, speed * t)
+        });
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(self.scale),
+            spin * self.rotation,
+            self.position,
+        )
+    }
+}
+
+/// An object's material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub color: Vec3,
+    pub lighting: Lighting,
+    pub specular: f32,
+    pub shininess: f32,
+    pub vertex_colors: bool,
+    pub texture: TextureMode,
+    /// A texture image given in the scene (else the model's map_Kd).
+    pub image: Option<PathBuf>,
+}
+
+/// An object's effects.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Effects {
+    pub depth_test: bool,
+    pub cull: bool,
+    pub fog: Option<FogFile>,
+    pub depth_shading: bool,
+    pub wireframe: bool,
+    pub silhouette: bool,
+}
+
+impl From<&EffectsFile> for Effects {
+    fn from(e: &EffectsFile) -> Self {
+        Self {
+            depth_test: e.depth_test,
+            cull: e.cull,
+            fog: e.fog,
+            depth_shading: e.depth_shading,
+            wireframe: e.wireframe,
+            silhouette: e.silhouette,
+        }
+    }
+}
+
+impl From<(&MaterialFile, &Path)> for Material {
+    fn from((m, scene): (&MaterialFile, &Path)) -> Self {
+        Self {
+            color: Vec3::from(m.color),
+            lighting: m.lighting,
+            specular: m.specular,
+            shininess: m.shininess,
+            vertex_colors: m.vertex_colors,
+            texture: m.texture,
+            image: m.image.as_deref().map(|i| file::relative(i, scene)),
+        }
+    }
+}
+
+/// An object ready to draw: its mesh holds only what the plan uses.
+#[derive(Clone, Debug)]
+pub struct SceneObject {
+    pub desc: ObjectDesc,
+    pub mesh: Mesh,
+    /// Unique edges (wireframe and silhouettes), else empty.
+    pub edges: Vec<[u32; 2]>,
+    /// For each edge, the one or two triangles that share it (silhouettes), else empty.
+    pub edge_faces: Vec<[u32; 2]>,
+    /// Flat lighting: each vertex's face centre, else empty.
+    pub face_centres: Vec<Vec3>,
+    pub texture: Option<Texture>,
+}
+
+/// A loaded scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Where it came from (for messages and the status line).
+    pub source: String,
+    pub camera: Camera,
+    pub background: Vec3,
+    pub lights: Vec<LightDesc>,
+    pub objects: Vec<SceneObject>,
+    pub plan: Plan,
+}
+
+/// The lights a lit object gets when the scene declares none.
+#[must_use]
+pub fn standard_lights() -> Vec<LightDesc> {
+    vec![
+        LightDesc {
+            kind: LightKind::Ambient,
+            color: Vec3::splat(0.08),
+            vector: Vec3::ZERO,
+        },
+        LightDesc {
+            kind: LightKind::Directional,
+            color: Vec3::splat(0.92),
+            vector: crate::render::shaders::standard_light(),
+        },
+    ]
+}
+
+/// Whether a model argument names a scene file rather than a model.
+#[must_use]
+pub fn is_scene_path(spec: &str) -> bool {
+    Path::new(spec)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+}
+
+impl Scene {
+    /// The default scene of a model (what an OBJ path is shorthand for): the model
+    /// with depth test and per-pixel Lambert under the standard lights, as the viewer
+    /// and the benchmark show it.
+    pub fn for_model(spec: &str) -> Result<Self, SceneError> {
+        let text = format!(
+            "[[object]]\nmodel = {}\n[object.material]\nlighting = \"lambert\"\n[object.effects]\ndepth_test = true\n",
+            toml::Value::String(spec.to_string())
+        );
+        let mut scene = Self::from_text(&text, Path::new("default scene"))?;
+        scene.source = format!("{spec} (default scene)");
+        Ok(scene)
+    }
+
+    /// Reads and loads a scene file.
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.into(),
+            source,
+        })?;
+        Self::from_text(&text, path)
+    }
+
+    /// Loads a scene from its text; `path` names it and anchors relative paths.
+    pub fn from_text(text: &str, path: &Path) -> Result<Self, SceneError> {
+        let f = file::parse(text, path)?;
+        let c = &f.camera;
+        let camera = Camera {
+            eye: Vec3::from(c.eye),
+            target: Vec3::from(c.target),
+            up: Vec3::from(c.up),
+            fov_y: c.fov.to_radians(),
+            near: c.near,
+            far: c.far,
+        };
+        let mut lights: Vec<LightDesc> = f
+            .lights
+            .iter()
+            .map(|l| LightDesc {
+                kind: l.kind,
+                color: Vec3::from(l.color.unwrap_or([1.0; 3])) * l.intensity.unwrap_or(1.0),
+                vector: match l.kind {
+                    LightKind::Ambient => Vec3::ZERO,
+                    LightKind::Directional => {
+                        Vec3::from(l.direction.unwrap_or([0.4, 0.6, 1.0])).normalize()
+                    }
+                    LightKind::Point => Vec3::from(l.position.unwrap_or([2.0, 2.0, 2.0])),
+                },
+            })
+            .collect();
+        let lit = f
+            .objects
+            .iter()
+            .any(|o| o.material.lighting != Lighting::None);
+        if lights.is_empty() && lit {
+            lights = standard_lights();
+        }
+        let descs: Vec<ObjectDesc> = f
+            .objects
+            .iter()
+            .map(|o| ObjectDesc {
+                name: o.model.clone(),
+                model: file::resolve(&o.model, path),
+                position: Vec3::from(o.position),
+                rotation: {
+                    let r = o.rotation.map(f32::to_radians);
+                    Quat::from_euler(EulerRot::ZYX, r[2], r[1], r[0])
+                },
+                scale: o.scale,
+                spin: o
+                    .spin
+                    .as_ref()
+                    .map(|s| (Vec3::from(s.axis).normalize(), s.speed)),
+                material: Material::from((&o.material, path)),
+                effects: Effects::from(&o.effects),
+            })
+            .collect();
+        let plan = Plan::new(&descs, &lights, f.render.antialias);
+        let objects = descs
+            .into_iter()
+            .zip(&plan.objects)
+            .enumerate()
+            .map(|(i, (desc, op))| load_object(desc, op, path, i + 1))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            source: path.display().to_string(),
+            camera,
+            background: Vec3::from(f.render.background),
+            lights,
+            objects,
+            plan,
+        })
+    }
+}
+
+/// Loads an object's model and keeps, derives and drops exactly what its plan says.
+fn load_object(
+    desc: ObjectDesc,
+    op: &plan::ObjectPlan,
+    scene: &Path,
+    n: usize,
+) -> Result<SceneObject, SceneError> {
+    let mut mesh = Mesh::from_spec(&desc.model).map_err(|source| SceneError::Model {
+        scene: scene.into(),
+        object: n,
+        source,
+    })?;
+    let unsupported = |problem: String| SceneError::Unsupported {
+        scene: scene.into(),
+        object: n,
+        model: desc.model.clone(),
+        problem,
+    };
+    if op.vertex_colors && mesh.colors.is_empty() {
+        return Err(unsupported(
+            "material.vertex_colors = true, but the model has no vertex colours (`v x y z r g b`)"
+                .into(),
+        ));
+    }
+    if op.uvs && mesh.uvs.is_empty() {
+        return Err(unsupported(
+            "material.texture is on, but the model has no texture coordinates (`vt`)".into(),
+        ));
+    }
+    let texture = if op.texture == TextureMode::Off {
+        None
+    } else {
+        let file = match (&desc.material.image, &mesh.texture) {
+            (Some(image), _) => image.clone(),
+            (None, Ok(Some(t))) => t.clone(),
+            (None, Ok(None)) => {
+                return Err(unsupported(
+                    "material.texture is on, but the model's material has no map_Kd: set material.image".into(),
+                ));
+            }
+            (None, Err(problem)) => return Err(unsupported(problem.clone())),
+        };
+        Some(Texture::load(&file)?)
+    };
+    // Drop what no stage reads: the mesh then holds exactly the attributes the plan
+    // transforms.
+    if !op.vertex_colors {
+        mesh.colors = Vec::new();
+    }
+    if !op.uvs {
+        mesh.uvs = Vec::new();
+    }
+    // Edge topology comes from the mesh as loaded, with vertices identified by
+    // position (so texture seams and the per-face split below are not edges).
+    let topology = op.edges.then(|| Topology::of(&mesh));
+    let original_indices = op.edges.then(|| mesh.indices.clone());
+    let mut face_centres = Vec::new();
+    if op.unweld {
+        // Flat lighting: every face gets its own three vertices with the face normal.
+        let mut flat = Mesh {
+            name: mesh.name.clone(),
+            texture: mesh.texture.clone(),
+            ..Mesh::default()
+        };
+        for t in mesh.indices.chunks_exact(3) {
+            let p = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
+            let normal = (p[1] - p[0])
+                .cross(p[2] - p[0])
+                .try_normalize()
+                .unwrap_or(Vec3::Z);
+            let centre = (p[0] + p[1] + p[2]) / 3.0;
+            for &i in t {
+                flat.indices.push(flat.positions.len() as u32);
+                flat.positions.push(mesh.positions[i as usize]);
+                flat.normals.push(normal);
+                face_centres.push(centre);
+                if let Some(c) = mesh.colors.get(i as usize) {
+                    flat.colors.push(*c);
+                }
+                if let Some(uv) = mesh.uvs.get(i as usize) {
+                    flat.uvs.push(*uv);
+                }
+            }
+        }
+        mesh = flat;
+    } else if op.normals {
+        mesh.ensure_normals();
+    } else {
+        mesh.normals = Vec::new();
+    }
+    let (edges, edge_faces) = match (topology, original_indices) {
+        (Some(t), Some(original)) => {
+            // Each edge as two vertices of the mesh that is drawn: the corners of its
+            // first face (the per-face split keeps faces in order).
+            let corner = |face: u32, v: u32| -> u32 {
+                let f = face as usize * 3;
+                let k = t.indices[f..f + 3]
+                    .iter()
+                    .position(|&c| c == v)
+                    .unwrap_or(0);
+                if op.unweld {
+                    (f + k) as u32
+                } else {
+                    original[f + k]
+                }
+            };
+            let edges = t
+                .edges
+                .iter()
+                .zip(&t.faces)
+                .map(|(&[a, b], f)| [corner(f[0], a), corner(f[0], b)])
+                .collect();
+            (edges, if op.silhouette { t.faces } else { Vec::new() })
+        }
+        _ => (Vec::new(), Vec::new()),
+    };
+    Ok(SceneObject {
+        desc,
+        mesh,
+        edges,
+        edge_faces,
+        face_centres,
+        texture,
+    })
+}
+
+/// Edges of a mesh with vertices identified by position.
+struct Topology {
+    /// The triangles' corners as position ids.
+    indices: Vec<u32>,
+    /// Unique edges over position ids.
+    edges: Vec<[u32; 2]>,
+    /// The faces of each edge.
+    faces: Vec<[u32; 2]>,
+}
+
+impl Topology {
+    fn of(mesh: &Mesh) -> Self {
+        let mut ids = std::collections::HashMap::new();
+        let id: Vec<u32> = mesh
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                *ids.entry(p.to_array().map(f32::to_bits))
+                    .or_insert(i as u32)
+            })
+            .collect();
+        let indices: Vec<u32> = mesh.indices.iter().map(|&i| id[i as usize]).collect();
+        let edges = unique_edges(&indices);
+        let faces = edge_faces(&indices, &edges);
+        Self {
+            indices,
+            edges,
+            faces,
+        }
+    }
+}
+
+/// For each unique edge, the triangles that share it (the second is `u32::MAX` on a
+/// boundary; edges shared by more than two keep the first two).
+fn edge_faces(indices: &[u32], edges: &[[u32; 2]]) -> Vec<[u32; 2]> {
+    let mut faces = vec![[u32::MAX; 2]; edges.len()];
+    for (t, tri) in indices.chunks_exact(3).enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            let key = [a.min(b), a.max(b)];
+            if let Ok(e) = edges.binary_search(&key) {
+                let f = &mut faces[e];
+                if f[0] == u32::MAX {
+                    f[0] = t as u32;
+                } else if f[1] == u32::MAX {
+                    f[1] = t as u32;
+                }
+            }
+        }
+    }
+    faces
+}

@@ -1,0 +1,713 @@
+//! Rendering a scene by its plan.
+//!
+//! Each object's varying set ([`VaryingSet`]) picks one of 16 pipelines when the scene
+//! is loaded: [`ObjectShader`] is generic over four slots (normal, world position,
+//! colour, uv), each [`On`] or [`Off`]. An `Off` slot's varying is `()`, so it is
+//! neither computed in the vertex stage nor interpolated per fragment, and the
+//! fragment code that reads it is compiled out. The choice is made once per object
+//! (a trait object per object, called once per frame); nothing is dispatched per
+//! vertex or pixel.
+
+use std::marker::PhantomData;
+
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+
+use super::file::{LightKind, Lighting};
+use super::plan::{ObjectPlan, VaryingSet};
+use super::{LightDesc, Scene, SceneObject};
+use crate::accuracy::area::grid_side;
+use crate::counters::{self, Stage};
+use crate::raster::Target;
+use crate::raster::depth::{DepthBuffer, DepthState};
+use crate::raster::interp::Varying;
+use crate::raster::probe::{Probe, probe_from};
+use crate::render::standard::WIRE_COLOR;
+use crate::render::wire::{WIRE_DEPTH_BIAS, draw_wireframe};
+use crate::render::{
+    Cull, DrawOptions, DrawStats, Renderer, Rgba8, Shader, VertexCache, transform,
+};
+
+/// A varying slot: present ([`On`]) or absent ([`Off`]) at compile time.
+pub trait Slot<T>: 'static {
+    type V: Varying;
+    const ON: bool;
+    /// The slot's varying; `f` runs only when the slot is on.
+    fn pack(f: impl FnOnce() -> T) -> Self::V;
+    /// The interpolated value (a default when off; code reading it is compiled out
+    /// behind `ON`).
+    fn get(v: &Self::V) -> T;
+}
+
+/// A slot that is interpolated.
+#[derive(Debug)]
+pub struct On;
+/// A slot that does not exist.
+#[derive(Debug)]
+pub struct Off;
+
+impl<T: Varying> Slot<T> for On {
+    type V = T;
+    const ON: bool = true;
+    #[inline(always)]
+    fn pack(f: impl FnOnce() -> T) -> T {
+        f()
+    }
+    #[inline(always)]
+    fn get(v: &T) -> T {
+        *v
+    }
+}
+
+impl<T: Default> Slot<T> for Off {
+    type V = ();
+    const ON: bool = false;
+    #[inline(always)]
+    fn pack(_: impl FnOnce() -> T) {}
+    #[inline(always)]
+    fn get(_: &()) -> T {
+        T::default()
+    }
+}
+
+/// The varyings of a pipeline: normal, position, colour, uv (nested pairs).
+pub type Varyings<N, P, C, U> = (
+    <N as Slot<Vec3>>::V,
+    (
+        <P as Slot<Vec3>>::V,
+        (<C as Slot<Vec3>>::V, <U as Slot<Vec2>>::V),
+    ),
+);
+
+/// What every object of a frame shares.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameCtx<'a> {
+    pub view_proj: Mat4,
+    pub eye: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+    pub lights: &'a [LightDesc],
+    /// View depths mapped to bright and dark by depth shading.
+    pub depth_range: (f32, f32),
+    pub target: Target,
+    pub time: f32,
+}
+
+/// The shader of one object in one of the 16 pipelines.
+pub struct ObjectShader<'a, N, P, C, U> {
+    pub obj: &'a SceneObject,
+    pub plan: &'a ObjectPlan,
+    pub ctx: FrameCtx<'a>,
+    pub model: Mat4,
+    pub normal_matrix: Mat3,
+    pub mvp: Mat4,
+    _slots: PhantomData<(N, P, C, U)>,
+}
+
+impl<'a, N, P, C, U> ObjectShader<'a, N, P, C, U> {
+    /// The shader for an object at this frame.
+    #[must_use]
+    pub fn new(obj: &'a SceneObject, plan: &'a ObjectPlan, ctx: FrameCtx<'a>) -> Self {
+        let model = obj.desc.model_matrix(ctx.time);
+        Self {
+            obj,
+            plan,
+            ctx,
+            model,
+            normal_matrix: Mat3::from_mat4(model).inverse().transpose(),
+            mvp: ctx.view_proj * model,
+            _slots: PhantomData,
+        }
+    }
+
+    /// Diffuse (and, with `specular`, Blinn–Phong) light at a point, times `base`.
+    fn light(&self, normal: Vec3, at: Vec3, specular: bool, base: Vec3) -> Vec3 {
+        counters::add(Stage::Lighting, 1);
+        let m = &self.obj.desc.material;
+        let n = normal.normalize_or_zero();
+        let view = (self.ctx.eye - at).normalize_or_zero();
+        let (mut diffuse, mut spec) = (Vec3::ZERO, Vec3::ZERO);
+        for l in self.ctx.lights {
+            let (dir, power) = match l.kind {
+                LightKind::Ambient => {
+                    diffuse += l.color;
+                    continue;
+                }
+                LightKind::Directional => (l.vector, l.color),
+                LightKind::Point => {
+                    let d = l.vector - at;
+                    (d.normalize_or_zero(), l.color / (1.0 + d.length_squared()))
+                }
+            };
+            let ndl = n.dot(dir);
+            if ndl > 0.0 {
+                diffuse += power * ndl;
+                if specular {
+                    let h = (dir + view).normalize_or_zero();
+                    spec += power * m.specular * n.dot(h).max(0.0).powf(m.shininess);
+                }
+            }
+        }
+        base * diffuse + spec
+    }
+
+    fn view_depth(&self, world: Vec3) -> f32 {
+        (world - self.ctx.eye).dot(self.ctx.forward)
+    }
+}
+
+impl<N, P, C, U> Shader for ObjectShader<'_, N, P, C, U>
+where
+    N: Slot<Vec3>,
+    P: Slot<Vec3>,
+    C: Slot<Vec3>,
+    U: Slot<Vec2>,
+{
+    type Varying = Varyings<N, P, C, U>;
+
+    fn vertex(&self, index: u32) -> (Vec4, Self::Varying) {
+        let i = index as usize;
+        let mesh = &self.obj.mesh;
+        let p = mesh.positions.get(i).copied().unwrap_or(Vec3::ZERO);
+        let plan = self.plan;
+        let world = if plan.world_positions {
+            counters::add(Stage::PositionsToWorld, 1);
+            self.model.transform_point3(p)
+        } else {
+            Vec3::ZERO
+        };
+        let normal = if plan.normals {
+            counters::add(Stage::NormalsTransformed, 1);
+            let n = mesh.normals.get(i).copied().unwrap_or(Vec3::Z);
+            (self.normal_matrix * n).normalize_or_zero()
+        } else {
+            Vec3::ZERO
+        };
+        let color = C::pack(|| {
+            let mut c = Vec3::ONE;
+            if plan.vertex_colors {
+                counters::add(Stage::VertexColors, 1);
+                c *= mesh.colors.get(i).copied().unwrap_or(Vec3::ONE);
+            }
+            if self.obj.desc.material.lighting.per_vertex() && !plan.depth_shading {
+                // Flat: lit at the face centre, so all three corners agree.
+                let at = match self.obj.face_centres.get(i) {
+                    Some(c) if plan.unweld => self.model.transform_point3(*c),
+                    _ => world,
+                };
+                c = self.light(normal, at, false, c);
+            }
+            c
+        });
+        let uv = U::pack(|| {
+            counters::add(Stage::Uvs, 1);
+            mesh.uvs.get(i).copied().unwrap_or(Vec2::ZERO)
+        });
+        (
+            self.mvp * p.extend(1.0),
+            (N::pack(|| normal), (P::pack(|| world), (color, uv))),
+        )
+    }
+
+    fn fragment(&self, v: &Self::Varying) -> Vec3 {
+        let (n, (p, (c, uv))) = v;
+        let plan = self.plan;
+        let world = P::get(p);
+        if plan.depth_shading {
+            counters::add(Stage::DepthShading, 1);
+            let (near, far) = self.ctx.depth_range;
+            let t = ((self.view_depth(world) - near) / (far - near).max(1e-6)).clamp(0.0, 1.0);
+            return Vec3::splat(1.0 - 0.85 * t);
+        }
+        let m = &self.obj.desc.material;
+        let mut color = m.color;
+        if C::ON {
+            color *= C::get(c);
+        }
+        if let (true, Some(t)) = (U::ON, &self.obj.texture) {
+            color *= t.sample(U::get(uv), plan.texture);
+        }
+        if N::ON {
+            color = self.light(N::get(n), world, m.lighting == Lighting::BlinnPhong, color);
+        }
+        if let Some(fog) = self.obj.desc.effects.fog {
+            counters::add(Stage::Fog, 1);
+            let d = self.view_depth(world);
+            let t = ((fog.end - d) / (fog.end - fog.start)).clamp(0.0, 1.0);
+            color = Vec3::from(fog.color).lerp(color, t);
+        }
+        color
+    }
+}
+
+/// A silhouette edge on screen, in sample coordinates (pixel centres at +0.5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Silhouette {
+    pub a: Vec2,
+    pub b: Vec2,
+}
+
+/// One object's pipeline: its monomorphized shader and its vertex cache.
+pub trait ObjectPipeline {
+    /// Transforms and draws the object.
+    fn draw(
+        &mut self,
+        obj: &SceneObject,
+        plan: &ObjectPlan,
+        ctx: FrameCtx<'_>,
+        r: &mut Renderer,
+        color: &mut Rgba8,
+    );
+    /// Draws the object's edges; returns pixels written.
+    fn wireframe(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<&DepthBuffer>,
+        color: &mut Rgba8,
+    ) -> u64;
+    /// Appends the object's silhouette edges, in the coordinates of `target`.
+    fn silhouettes(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<(&DepthBuffer, u32)>,
+        out: &mut Vec<Silhouette>,
+    );
+    /// The raster state of a pixel for this object, continuing from `stored` depth.
+    fn probe(
+        &self,
+        obj: &SceneObject,
+        plan: &ObjectPlan,
+        target: Target,
+        x: u32,
+        y: u32,
+        stored: f32,
+    ) -> Probe<()>;
+    /// The varying set this pipeline was compiled for.
+    fn varyings(&self) -> VaryingSet;
+}
+
+/// The draw options an object's plan asks for.
+#[must_use]
+pub fn draw_options(plan: &ObjectPlan) -> DrawOptions {
+    DrawOptions {
+        depth: if plan.depth_test {
+            DepthState::default()
+        } else {
+            DepthState::OFF
+        },
+        cull: if plan.cull { Cull::Back } else { Cull::None },
+        ..DrawOptions::default()
+    }
+}
+
+struct Pipeline<N: Slot<Vec3>, P: Slot<Vec3>, C: Slot<Vec3>, U: Slot<Vec2>> {
+    cache: VertexCache<Varyings<N, P, C, U>>,
+}
+
+impl<N, P, C, U> ObjectPipeline for Pipeline<N, P, C, U>
+where
+    N: Slot<Vec3>,
+    P: Slot<Vec3>,
+    C: Slot<Vec3>,
+    U: Slot<Vec2>,
+{
+    fn draw(
+        &mut self,
+        obj: &SceneObject,
+        plan: &ObjectPlan,
+        ctx: FrameCtx<'_>,
+        r: &mut Renderer,
+        color: &mut Rgba8,
+    ) {
+        let shader = ObjectShader::<N, P, C, U>::new(obj, plan, ctx);
+        transform(&shader, obj.mesh.positions.len(), &mut self.cache);
+        r.draw(
+            &shader,
+            &self.cache,
+            &obj.mesh.indices,
+            &draw_options(plan),
+            color,
+        );
+    }
+
+    fn wireframe(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<&DepthBuffer>,
+        color: &mut Rgba8,
+    ) -> u64 {
+        counters::add(Stage::WireEdges, obj.edges.len() as u64);
+        draw_wireframe(&self.cache, &obj.edges, target, depth, WIRE_COLOR, color)
+    }
+
+    fn silhouettes(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<(&DepthBuffer, u32)>,
+        out: &mut Vec<Silhouette>,
+    ) {
+        let verts = &self.cache.verts;
+        let idx = &obj.mesh.indices;
+        // Facing of a triangle: the sign of its doubled area in NDC (w > 0 only).
+        let facing = |t: u32| -> Option<bool> {
+            let tri = idx.get(t as usize * 3..t as usize * 3 + 3)?;
+            let p = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).map(|v| v.pos));
+            let [Some(a), Some(b), Some(c)] = p else {
+                return None;
+            };
+            if a.w <= 0.0 || b.w <= 0.0 || c.w <= 0.0 {
+                return None;
+            }
+            let (a, b, c) = (a.truncate() / a.w, b.truncate() / b.w, c.truncate() / c.w);
+            Some((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) > 0.0)
+        };
+        let (w, h) = (target.width as f32, target.height as f32);
+        for (e, faces) in obj.edges.iter().zip(&obj.edge_faces) {
+            let front = facing(faces[0]);
+            let other = if faces[1] == u32::MAX {
+                None
+            } else {
+                facing(faces[1])
+            };
+            let silhouette = match (front, other) {
+                (Some(a), Some(b)) => a != b,
+                (Some(a), None) => a, // a boundary edge of a front face
+                _ => false,
+            };
+            if !silhouette {
+                continue;
+            }
+            let (Some(a), Some(b)) = (verts.get(e[0] as usize), verts.get(e[1] as usize)) else {
+                continue;
+            };
+            let (a, b) = (a.pos, b.pos);
+            if a.w <= 0.0 || b.w <= 0.0 {
+                continue;
+            }
+            let screen =
+                |p: Vec4| Vec2::new((p.x / p.w * 0.5 + 0.5) * w, (0.5 - p.y / p.w * 0.5) * h);
+            // Hidden silhouettes (behind other surfaces) are left out when depth exists:
+            // the midpoint is tested like a wireframe pixel.
+            if let Some((d, side)) = depth {
+                let m = (a + b) * 0.5;
+                let s = screen(m);
+                let (x, y) = ((s.x * side as f32) as u32, (s.y * side as f32) as u32);
+                if x < d.width && y < d.height {
+                    let z = m.z / m.w;
+                    if z - WIRE_DEPTH_BIAS * 10.0 > d.data[(y * d.width + x) as usize] {
+                        continue;
+                    }
+                }
+            }
+            counters::add(Stage::SilhouetteEdges, 1);
+            out.push(Silhouette {
+                a: screen(a),
+                b: screen(b),
+            });
+        }
+    }
+
+    fn probe(
+        &self,
+        obj: &SceneObject,
+        plan: &ObjectPlan,
+        target: Target,
+        x: u32,
+        y: u32,
+        stored: f32,
+    ) -> Probe<()> {
+        // Probe on positions only: coverage, barycentrics and depth do not depend on
+        // the varyings.
+        let positions = VertexCache {
+            verts: self
+                .cache
+                .verts
+                .iter()
+                .map(|v| crate::raster::clip::ClipVertex {
+                    pos: v.pos,
+                    var: (),
+                })
+                .collect(),
+        };
+        probe_from(
+            &positions,
+            &obj.mesh.indices,
+            target,
+            &draw_options(plan),
+            x,
+            y,
+            stored,
+        )
+    }
+
+    fn varyings(&self) -> VaryingSet {
+        VaryingSet {
+            normal: N::ON,
+            position: P::ON,
+            color: C::ON,
+            uv: U::ON,
+        }
+    }
+}
+
+/// The pipeline compiled for a varying set.
+#[must_use]
+pub fn pipeline_for(v: VaryingSet) -> Box<dyn ObjectPipeline> {
+    fn u<N: Slot<Vec3>, P: Slot<Vec3>, C: Slot<Vec3>>(v: VaryingSet) -> Box<dyn ObjectPipeline> {
+        if v.uv {
+            Box::new(Pipeline::<N, P, C, On> {
+                cache: VertexCache::default(),
+            })
+        } else {
+            Box::new(Pipeline::<N, P, C, Off> {
+                cache: VertexCache::default(),
+            })
+        }
+    }
+    fn c<N: Slot<Vec3>, P: Slot<Vec3>>(v: VaryingSet) -> Box<dyn ObjectPipeline> {
+        if v.color {
+            u::<N, P, On>(v)
+        } else {
+            u::<N, P, Off>(v)
+        }
+    }
+    fn p<N: Slot<Vec3>>(v: VaryingSet) -> Box<dyn ObjectPipeline> {
+        if v.position {
+            c::<N, On>(v)
+        } else {
+            c::<N, Off>(v)
+        }
+    }
+    if v.normal { p::<On>(v) } else { p::<Off>(v) }
+}
+
+/// Where a scene is seen from in one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneView {
+    /// Seconds since the start (spins).
+    pub time: f32,
+    /// Orbit of the camera about its target: radians about y, then about x.
+    pub yaw: f32,
+    pub pitch: f32,
+    /// Camera distance divisor (1 = as in the file).
+    pub zoom: f32,
+    /// Pixel width over height of the target's samples.
+    pub pixel_aspect: f32,
+}
+
+impl Default for SceneView {
+    fn default() -> Self {
+        Self {
+            time: 0.0,
+            yaw: 0.0,
+            pitch: 0.0,
+            zoom: 1.0,
+            pixel_aspect: 1.0,
+        }
+    }
+}
+
+/// Buffers and pipelines for drawing a scene; reused from frame to frame.
+pub struct SceneFrame {
+    pub renderer: Renderer,
+    /// The frame at the requested size (alpha 255 where covered).
+    pub color: Rgba8,
+    /// The supersampled frame (empty when the plan has no supersampling).
+    fine: Rgba8,
+    pipelines: Vec<Box<dyn ObjectPipeline>>,
+    pub silhouettes: Vec<Silhouette>,
+    /// Counters of the last frame, all objects.
+    pub stats: DrawStats,
+    pub wire_pixels: u64,
+    /// The size the frame was drawn at and the camera used.
+    pub target: Target,
+    pub ctx_view_proj: Mat4,
+}
+
+impl std::fmt::Debug for SceneFrame {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneFrame")
+            .field("target", &self.target)
+            .field("stats", &self.stats)
+            .finish_non_exhaustive()
+    }
+}
+
+impl SceneFrame {
+    /// Pipelines for a scene's objects, by its plan.
+    #[must_use]
+    pub fn new(scene: &Scene) -> Self {
+        Self {
+            renderer: Renderer::new(Target::new(1, 1)),
+            color: Rgba8::default(),
+            fine: Rgba8::default(),
+            pipelines: scene
+                .plan
+                .objects
+                .iter()
+                .map(|o| pipeline_for(o.varyings))
+                .collect(),
+            silhouettes: Vec::new(),
+            stats: DrawStats::default(),
+            wire_pixels: 0,
+            target: Target::new(1, 1),
+            ctx_view_proj: Mat4::IDENTITY,
+        }
+    }
+
+    /// The varying sets the pipelines were compiled for, per object.
+    #[must_use]
+    pub fn varyings(&self) -> Vec<VaryingSet> {
+        self.pipelines.iter().map(|p| p.varyings()).collect()
+    }
+
+    /// Draws a frame of `target` samples.
+    pub fn draw(&mut self, scene: &Scene, target: Target, view: &SceneView) {
+        let plan = &scene.plan;
+        let side = grid_side(plan.samples);
+        let fine = Target::new(target.width * side, target.height * side);
+        let cam = &scene.camera;
+        let orbit = Mat3::from_rotation_y(view.yaw) * Mat3::from_rotation_x(view.pitch);
+        let eye = cam.target + orbit * (cam.eye - cam.target) / view.zoom.max(0.05);
+        let camera = crate::camera::Camera {
+            eye,
+            up: orbit * cam.up,
+            ..*cam
+        };
+        let view_proj =
+            camera.projection(fine.width, fine.height, view.pixel_aspect) * camera.view();
+        let forward = (cam.target - eye).normalize_or_zero();
+        // Depth shading spans the objects' bounding spheres along the view.
+        let depth_range = scene
+            .objects
+            .iter()
+            .map(|o| {
+                let c = o.desc.model_matrix(view.time).transform_point3(Vec3::ZERO);
+                let r = o.desc.scale * 3f32.sqrt();
+                let d = (c - eye).dot(forward);
+                (d - r, d + r)
+            })
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |a, b| {
+                (a.0.min(b.0), a.1.max(b.1))
+            });
+        let depth_range = if depth_range.0.is_finite() {
+            (
+                depth_range.0.max(cam.near),
+                depth_range.1.max(cam.near + 1e-3),
+            )
+        } else {
+            (cam.near, cam.far)
+        };
+        let ctx = FrameCtx {
+            view_proj,
+            eye,
+            forward,
+            lights: &scene.lights,
+            depth_range,
+            target: fine,
+            time: view.time,
+        };
+        let color = if side > 1 {
+            &mut self.fine
+        } else {
+            &mut self.color
+        };
+        self.renderer
+            .begin_frame_with(fine, color, scene.background, plan.depth_buffer);
+        let mut stats = DrawStats::default();
+        for ((obj, op), pipe) in scene
+            .objects
+            .iter()
+            .zip(&plan.objects)
+            .zip(&mut self.pipelines)
+        {
+            pipe.draw(obj, op, ctx, &mut self.renderer, color);
+            stats += self.renderer.stats;
+            self.renderer.stats = DrawStats::default();
+        }
+        self.wire_pixels = 0;
+        for ((obj, op), pipe) in scene.objects.iter().zip(&plan.objects).zip(&self.pipelines) {
+            if op.wireframe {
+                let depth = op.hidden_lines.then_some(&self.renderer.depth);
+                self.wire_pixels += pipe.wireframe(obj, fine, depth, color);
+            }
+        }
+        self.silhouettes.clear();
+        for ((obj, op), pipe) in scene.objects.iter().zip(&plan.objects).zip(&self.pipelines) {
+            if op.silhouette {
+                let depth = op.depth_test.then_some((&self.renderer.depth, side));
+                pipe.silhouettes(obj, target, depth, &mut self.silhouettes);
+            }
+        }
+        if side > 1 {
+            resolve(
+                &self.fine,
+                fine,
+                side,
+                &mut self.color,
+                target,
+                scene.background,
+            );
+        }
+        self.stats = stats;
+        self.target = target;
+        self.ctx_view_proj = view_proj;
+    }
+
+    /// Probes sample `(x, y)` of the last frame (without supersampling) for every
+    /// object in draw order, the depth carried from one object to the next.
+    #[must_use]
+    pub fn probe(&self, scene: &Scene, x: u32, y: u32) -> Vec<Probe<()>> {
+        let mut stored = crate::raster::depth::DEPTH_CLEAR;
+        let mut out = Vec::new();
+        for ((obj, op), pipe) in scene
+            .objects
+            .iter()
+            .zip(&scene.plan.objects)
+            .zip(&self.pipelines)
+        {
+            let p = pipe.probe(obj, op, self.renderer.target, x, y, stored);
+            stored = p.final_depth;
+            out.push(p);
+        }
+        out
+    }
+}
+
+/// Averages `side × side` blocks of `fine` into `out`: colour is the mean of the
+/// covered samples blended with the background by coverage, alpha is the coverage.
+fn resolve(fine: &Rgba8, ft: Target, side: u32, out: &mut Rgba8, target: Target, background: Vec3) {
+    let n = side * side;
+    let bg = background
+        .to_array()
+        .map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u32);
+    out.0.clear();
+    out.0.resize(target.len(), [0; 4]);
+    counters::add(Stage::Resolves, target.len() as u64);
+    for y in 0..target.height {
+        for x in 0..target.width {
+            let mut sum = [0u32; 3];
+            let mut covered = 0u32;
+            for j in 0..side {
+                let row = ((y * side + j) * ft.width + x * side) as usize;
+                for p in &fine.0[row..row + side as usize] {
+                    if p[3] == 255 {
+                        covered += 1;
+                        for c in 0..3 {
+                            sum[c] += u32::from(p[c]);
+                        }
+                    }
+                }
+            }
+            let px = &mut out.0[(y * target.width + x) as usize];
+            for c in 0..3 {
+                // Covered samples carry their colour, the others the background.
+                px[c] = ((sum[c] + bg[c] * (n - covered) + n / 2) / n) as u8;
+            }
+            px[3] = ((covered * 255 + n / 2) / n) as u8;
+        }
+    }
+}

@@ -3,6 +3,7 @@
 //! The binary calls [`main`]; everything here is library code so the tests can drive it.
 
 pub mod accuracy_cmd;
+pub mod effects_cmd;
 pub mod line_cmd;
 pub mod raster_cmd;
 pub mod render_cmd;
@@ -56,6 +57,8 @@ pub enum BenchCommand {
     /// The accuracy/speed table: every accuracy choice timed and checked against exact
     /// references (edge arithmetic, traversal, interpolation, anti-aliasing, depth).
     Accuracy(accuracy_cmd::AccuracyArgs),
+    /// What each scene effect costs: ms/frame with and without it.
+    Effects(effects_cmd::EffectsArgs),
 }
 
 /// Errors of the commands, each naming what it is about.
@@ -124,6 +127,9 @@ pub fn main() -> ExitCode {
             .and_then(|r| writeln!(io::stdout(), "{r}").map_err(Into::into)),
         Some(Command::Bench(BenchCommand::Accuracy(args))) => {
             accuracy_cmd::run_cmd(&args, &mut io::stdout().lock())
+        }
+        Some(Command::Bench(BenchCommand::Effects(args))) => {
+            effects_cmd::run(&args, &mut io::stdout().lock())
         }
         Some(Command::View(args)) => view_cmd::view(&args),
         None => view_cmd::view(&cli.view),

@@ -102,7 +102,7 @@ impl Mesh {
     }
 
     /// A UV sphere of radius 1 with about `triangles` triangles (at least 8), with exact
-    /// normals and texture coordinates.
+    /// normals, texture coordinates and vertex colours (the normal mapped to 0..1).
     #[must_use]
     pub fn uv_sphere(triangles: usize) -> Self {
         // stacks × slices quads, 2 triangles each (the pole rows are fans of 1 each).
@@ -126,6 +126,7 @@ impl Mesh {
                 m.positions.push(p);
                 m.normals.push(p);
                 m.uvs.push(Vec2::new(u, 1.0 - v));
+                m.colors.push(p * 0.5 + 0.5);
             }
         }
         let at = |i: u32, j: u32| i * (slices + 1) + j;

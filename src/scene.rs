@@ -54,6 +54,9 @@ use crate::camera::Camera;
 use crate::mesh::{Mesh, MeshError};
 use crate::render::wire::unique_edges;
 
+/// `image = "checker"`: a built-in checkerboard texture instead of a file.
+pub const BUILTIN_CHECKER: &str = "checker";
+
 /// Why a scene could not be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
@@ -135,7 +138,8 @@ pub struct Material {
     pub shininess: f32,
     pub vertex_colors: bool,
     pub texture: TextureMode,
-    /// A texture image given in the scene (else the model's map_Kd).
+    /// A texture image given in the scene (else the model's map_Kd); a path ending
+    /// in [`BUILTIN_CHECKER`] with no extension is the built-in checkerboard.
     pub image: Option<PathBuf>,
 }
 
@@ -355,6 +359,9 @@ fn load_object(
     let texture = if op.texture == TextureMode::Off {
         None
     } else {
+        if desc.material.image.as_deref().is_some_and(|i| i.ends_with(BUILTIN_CHECKER)) {
+            Some(Texture::checker(64, 64, 8, Vec3::new(0.9, 0.55, 0.16), Vec3::new(0.16, 0.35, 0.8)))
+        } else {
         let file = match (&desc.material.image, &mesh.texture) {
             (Some(image), _) => image.clone(),
             (None, Ok(Some(t))) => t.clone(),
@@ -366,6 +373,7 @@ fn load_object(
             (None, Err(problem)) => return Err(unsupported(problem.clone())),
         };
         Some(Texture::load(&file)?)
+        }
     };
     // Drop what no stage reads: the mesh then holds exactly the attributes the plan
     // transforms.

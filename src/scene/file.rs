@@ -200,7 +200,8 @@ pub struct MaterialFile {
     pub vertex_colors: bool,
     /// Sample the texture (the OBJ material's `map_Kd`, or `image`).
     pub texture: TextureMode,
-    /// A PNG to use instead of the OBJ material's `map_Kd` (relative to the scene).
+    /// A PNG to use instead of the OBJ material's `map_Kd` (relative to the scene), or
+    /// `checker` for a built-in 64×64 checkerboard.
     pub image: Option<String>,
 }
 

@@ -359,20 +359,31 @@ fn load_object(
     let texture = if op.texture == TextureMode::Off {
         None
     } else {
-        if desc.material.image.as_deref().is_some_and(|i| i.ends_with(BUILTIN_CHECKER)) {
-            Some(Texture::checker(64, 64, 8, Vec3::new(0.9, 0.55, 0.16), Vec3::new(0.16, 0.35, 0.8)))
+        if desc
+            .material
+            .image
+            .as_deref()
+            .is_some_and(|i| i.ends_with(BUILTIN_CHECKER))
+        {
+            Some(Texture::checker(
+                64,
+                64,
+                8,
+                Vec3::new(0.9, 0.55, 0.16),
+                Vec3::new(0.16, 0.35, 0.8),
+            ))
         } else {
-        let file = match (&desc.material.image, &mesh.texture) {
-            (Some(image), _) => image.clone(),
-            (None, Ok(Some(t))) => t.clone(),
-            (None, Ok(None)) => {
-                return Err(unsupported(
+            let file = match (&desc.material.image, &mesh.texture) {
+                (Some(image), _) => image.clone(),
+                (None, Ok(Some(t))) => t.clone(),
+                (None, Ok(None)) => {
+                    return Err(unsupported(
                     "material.texture is on, but the model's material has no map_Kd: set material.image".into(),
                 ));
-            }
-            (None, Err(problem)) => return Err(unsupported(problem.clone())),
-        };
-        Some(Texture::load(&file)?)
+                }
+                (None, Err(problem)) => return Err(unsupported(problem.clone())),
+            };
+            Some(Texture::load(&file)?)
         }
     };
     // Drop what no stage reads: the mesh then holds exactly the attributes the plan

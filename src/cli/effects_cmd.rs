@@ -35,10 +35,22 @@ pub const EFFECTS: [(&str, &str, &str); 17] = [
     ("lighting: Gouraud", "lighting = \"gouraud\"", ""),
     ("lighting: Lambert per pixel", "lighting = \"lambert\"", ""),
     ("lighting: Blinn-Phong", "lighting = \"blinn-phong\"", ""),
-    ("Lambert + a point light", "lighting = \"lambert\"\n[[light]]\nkind = \"point\"\nposition = [1.5, 1.0, 2.0]\nintensity = 4.0", ""),
+    (
+        "Lambert + a point light",
+        "lighting = \"lambert\"\n[[light]]\nkind = \"point\"\nposition = [1.5, 1.0, 2.0]\nintensity = 4.0",
+        "",
+    ),
     ("vertex colours", "vertex_colors = true", ""),
-    ("texture, nearest", "texture = \"nearest\"\nimage = \"checker\"", ""),
-    ("texture, bilinear", "texture = \"bilinear\"\nimage = \"checker\"", ""),
+    (
+        "texture, nearest",
+        "texture = \"nearest\"\nimage = \"checker\"",
+        "",
+    ),
+    (
+        "texture, bilinear",
+        "texture = \"bilinear\"\nimage = \"checker\"",
+        "",
+    ),
     ("fog", "", "fog = { start = 2.0, end = 3.5 }"),
     ("depth shading", "", "depth_shading = true"),
     ("wireframe, hidden lines removed", "", "wireframe = true"),
@@ -62,7 +74,11 @@ pub fn effect_scene(row: usize) -> String {
         None => (material, ""),
     };
     let depth = if row == 0 { "false" } else { "true" };
-    let ambient = if lights.is_empty() { "" } else { "[[light]]\nkind = \"ambient\"\nintensity = 0.1\n" };
+    let ambient = if lights.is_empty() {
+        ""
+    } else {
+        "[[light]]\nkind = \"ambient\"\nintensity = 0.1\n"
+    };
     format!(
         "[render]\nantialias = {antialias}\n{ambient}{lights}\n[[object]]\nmodel = \"{EFFECTS_MODEL}\"\nrotation = [20, 0, 0]\nspin = {{ speed = 0.5 }}\n[object.material]\n{material}\n[object.effects]\ndepth_test = {depth}\n{effects}\n"
     )

@@ -187,6 +187,10 @@ pub fn scene_inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub
         );
         overdraw_text(&mut t, p, op.depth_test);
     }
+    let _ = writeln!(
+        t,
+        "(the line panel traces models only; scene wireframes are drawn, not traced)"
+    );
     t
 }
 

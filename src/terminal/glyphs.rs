@@ -314,13 +314,24 @@ fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph {
     };
     // Uncovered samples sort first and can only be background.
     let first_covered = order.iter().position(|&k| samples[k].covered).unwrap_or(n);
-    let (mut best_err, mut split) = (u64::MAX, first_covered);
+    // Σx² is the same for every split, so the split with the least squared error is
+    // the one with the largest |S_a|²/a + |S_b|²/b (the between-group part). That is
+    // compared in f64 (two float divisions per split instead of two u64 divisions,
+    // which were most of the fit), and the integer error computed once at the end.
+    let norm2 = |p: &[u64; 4]| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) as f64;
+    let total = prefix[n];
+    let mut split = first_covered;
+    let mut best = f64::NEG_INFINITY;
     for cut in first_covered..n {
-        let e = sse(0, cut) + sse(cut, n);
-        if e < best_err {
-            (best_err, split) = (e, cut);
+        let a = prefix[cut];
+        let b = [total[0] - a[0], total[1] - a[1], total[2] - a[2], 0];
+        let part = |s: &[u64; 4], m: usize| if m == 0 { 0.0 } else { norm2(s) / m as f64 };
+        let score = part(&a, cut) + part(&b, n - cut);
+        if score > best {
+            (best, split) = (score, cut);
         }
     }
+    let best_err = sse(0, split) + sse(split, n);
     let (dark, bright) = order.split_at(split);
     let pattern = bright.iter().fold(0u8, |p, &i| p | 1 << i);
     let fg = mean(samples, bright.iter().copied());

@@ -322,11 +322,10 @@ fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph {
     let total = prefix[n];
     let mut split = first_covered;
     let mut best = f64::NEG_INFINITY;
-    for cut in first_covered..n {
-        let a = prefix[cut];
+    for (cut, a) in prefix.iter().enumerate().take(n).skip(first_covered) {
         let b = [total[0] - a[0], total[1] - a[1], total[2] - a[2], 0];
         let part = |s: &[u64; 4], m: usize| if m == 0 { 0.0 } else { norm2(s) / m as f64 };
-        let score = part(&a, cut) + part(&b, n - cut);
+        let score = part(a, cut) + part(&b, n - cut);
         if score > best {
             (best, split) = (score, cut);
         }

@@ -127,20 +127,10 @@ pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
         let mut settings = args.look.settings(args.scene.mode, args.scene.cull);
         settings.angle = args.angle;
         settings.tilt = 0.0;
-        let mut vp = crate::tui::viewport::Viewport::default();
-        let mut out = std::io::stdout().lock();
-        for n in 0..args.frames {
+        return text_frames(args, |vp, n| {
             settings.angle = args.angle + n as f32 * RADIANS_PER_FRAME;
             vp.render(&model, &settings, args.cols, args.rows);
-            if args.animate {
-                out.write_all(b"\x1b[H")?;
-            } else if n > 0 {
-                out.write_all(b"\n")?;
-            }
-            super::view_cmd::write_ansi(&vp, &mut out)?;
-        }
-        out.flush()?;
-        return Ok(());
+        });
     };
     let target = args.size;
     let mut frame = StandardFrame::new(target);
@@ -185,11 +175,23 @@ fn scene_frames(args: &PngArgs) -> Result<(), super::CliError> {
     let mut settings = args.look.settings(Mode::Fill, false);
     settings.angle = 0.0;
     settings.tilt = 0.0;
+    text_frames(args, |vp, n| {
+        let t = n as f32 * SCENE_SECONDS_PER_FRAME;
+        vp.render_scene(&scene, &mut frame, &settings, (args.cols, args.rows), t);
+    })
+}
+
+/// Writes `args.frames` frames as ANSI text to stdout; `render(vp, n)` draws frame
+/// `n` into the viewport. Frames are separated by a blank line, or start with
+/// cursor-home with `--animate`.
+fn text_frames(
+    args: &PngArgs,
+    mut render: impl FnMut(&mut crate::tui::viewport::Viewport, u32),
+) -> Result<(), super::CliError> {
     let mut vp = crate::tui::viewport::Viewport::default();
     let mut out = std::io::stdout().lock();
     for n in 0..args.frames {
-        let t = n as f32 * SCENE_SECONDS_PER_FRAME;
-        vp.render_scene(&scene, &mut frame, &settings, (args.cols, args.rows), t);
+        render(&mut vp, n);
         if args.animate {
             out.write_all(b"\x1b[H")?;
         } else if n > 0 {

@@ -11,7 +11,7 @@ use crate::render::Shader;
 use crate::render::standard::{Model, StandardFrame};
 use crate::render::target::luminance;
 use crate::render::wire::{ScreenLine, probe_lines, project_edge};
-use crate::terminal::glyphs::explain;
+use crate::terminal::glyphs::{Sample, explain};
 
 use super::app::SceneState;
 use super::viewport::Viewport;
@@ -30,14 +30,12 @@ fn hex(c: Option<[u8; 3]>) -> String {
     })
 }
 
-/// The inspector text for cell `(cx, cy)`, detailing sub-sample `sub`.
-#[must_use]
-pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize) -> String {
-    let mut t = String::new();
-    let Some(g) = vp.cell(cx, cy) else {
-        return "cursor outside the view".into();
-    };
+/// The first lines of the inspector: the cell's glyph and colours and why; with the
+/// cell's samples and their count. `None` outside the view.
+fn cell_header(vp: &Viewport, cx: u16, cy: u16) -> Option<(String, [Sample; 8], usize)> {
+    let g = vp.cell(cx, cy)?;
     let (samples, n) = vp.samples(cx, cy);
+    let mut t = String::new();
     let _ = writeln!(
         t,
         "cell ({cx},{cy})  glyph '{}'  fg {}  bg {}",
@@ -46,6 +44,15 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
         hex(g.bg)
     );
     let _ = writeln!(t, "  {}", explain(vp.settings.glyphs, &samples[..n], g));
+    Some((t, samples, n))
+}
+
+/// The inspector text for cell `(cx, cy)`, detailing sub-sample `sub`.
+#[must_use]
+pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize) -> String {
+    let Some((mut t, _, n)) = cell_header(vp, cx, cy) else {
+        return "cursor outside the view".into();
+    };
     let opts = vp.settings.options();
     let indices = &model.mesh.indices;
     let view = vp.settings.view();
@@ -135,19 +142,9 @@ fn overdraw_text<V>(t: &mut String, p: &Probe<V>, depth_test: bool) {
 /// object to object), with the object's pipeline.
 #[must_use]
 pub fn scene_inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub: usize) -> String {
-    let mut t = String::new();
-    let Some(g) = vp.cell(cx, cy) else {
+    let Some((mut t, samples, n)) = cell_header(vp, cx, cy) else {
         return "cursor outside the view".into();
     };
-    let (samples, n) = vp.samples(cx, cy);
-    let _ = writeln!(
-        t,
-        "cell ({cx},{cy})  glyph '{}'  fg {}  bg {}",
-        g.ch,
-        hex(g.fg),
-        hex(g.bg)
-    );
-    let _ = writeln!(t, "  {}", explain(vp.settings.glyphs, &samples[..n], g));
     for (k, smp) in samples[..n].iter().enumerate() {
         let mark = if k == sub % n { '>' } else { ' ' };
         let (x, y) = sample_pixel(vp, cx, cy, k);

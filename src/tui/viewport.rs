@@ -105,12 +105,7 @@ impl Default for Viewport {
 impl Viewport {
     /// Renders the model for a `cols × rows` cell area and fits every cell's glyph.
     pub fn render(&mut self, model: &Model, settings: &ViewSettings, cols: u16, rows: u16) {
-        let (sx, sy) = settings.glyphs.dims();
-        let target = Target::new(u32::from(cols) * sx, u32::from(rows) * sy);
-        self.settings = *settings;
-        self.cols = cols;
-        self.rows = rows;
-        self.target = target;
+        let target = self.lay_out(settings, cols, rows);
         let view = settings.view();
         self.wire_pixels = self.frame.draw(
             model,
@@ -134,12 +129,8 @@ impl Viewport {
         (cols, rows): (u16, u16),
         time: f32,
     ) {
+        let target = self.lay_out(settings, cols, rows);
         let (sx, sy) = settings.glyphs.dims();
-        let target = Target::new(u32::from(cols) * sx, u32::from(rows) * sy);
-        self.settings = *settings;
-        self.cols = cols;
-        self.rows = rows;
-        self.target = target;
         let view = SceneView {
             time,
             yaw: settings.angle,
@@ -187,6 +178,16 @@ impl Viewport {
             },
             &mut crate::raster::line::NoTrace,
         );
+    }
+
+    /// Takes the settings and cell area of a frame; returns its sample target.
+    fn lay_out(&mut self, settings: &ViewSettings, cols: u16, rows: u16) -> Target {
+        let (sx, sy) = settings.glyphs.dims();
+        self.settings = *settings;
+        self.cols = cols;
+        self.rows = rows;
+        self.target = Target::new(u32::from(cols) * sx, u32::from(rows) * sy);
+        self.target
     }
 
     /// Fits every cell's glyph and colours to its samples.

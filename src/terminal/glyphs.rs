@@ -268,6 +268,53 @@ pub fn fit_cell(mode: GlyphMode, samples: &[Sample], colorless: bool) -> CellGly
     }
 }
 
+/// The 19 compare-exchanges of an optimal sorting network for 8 elements: branch-free,
+/// where a general sort of 8 keys per cell was a tenth of the glyph fit.
+const SORT8: [(usize, usize); 19] = [
+    (0, 2),
+    (1, 3),
+    (4, 6),
+    (5, 7),
+    (0, 4),
+    (1, 5),
+    (2, 6),
+    (3, 7),
+    (0, 1),
+    (2, 3),
+    (4, 5),
+    (6, 7),
+    (2, 4),
+    (3, 5),
+    (1, 4),
+    (3, 6),
+    (1, 2),
+    (3, 4),
+    (5, 6),
+];
+
+/// `1/m` for group sizes 0..=8 (0 for an empty group, whose sum is 0 anyway).
+const INV: [f32; 9] = [
+    0.0,
+    1.0,
+    1.0 / 2.0,
+    1.0 / 3.0,
+    1.0 / 4.0,
+    1.0 / 5.0,
+    1.0 / 6.0,
+    1.0 / 7.0,
+    1.0 / 8.0,
+];
+
+/// Sorts 8 keys ascending.
+#[inline]
+fn sort8(k: &mut [u32; 8]) {
+    for (i, j) in SORT8 {
+        let (a, b) = (k[i], k[j]);
+        k[i] = a.min(b);
+        k[j] = a.max(b);
+    }
+}
+
 /// The best split of the samples, ordered by luminance, into a dark and a bright group.
 /// Prefix sums of colour and squared colour give each split's squared error
 /// (`Σx² − (Σx)²/n` per channel) in constant time.
@@ -283,17 +330,18 @@ fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph {
     for (i, k) in keys.iter_mut().enumerate() {
         *k = *k << 3 | i as u32;
     }
-    let keys = &mut keys[..n];
-    keys.sort_unstable();
+    // Padding keys (u32::MAX) sort last, so the first n are the samples in order.
+    sort8(&mut keys);
     let mut order = [0usize; 8];
     for (o, k) in order.iter_mut().zip(keys.iter()) {
         *o = (k & 7) as usize;
     }
     let order = &order[..n];
-    // prefix[i] = sums over order[..i]: (Σr, Σg, Σb, Σr²+Σg²+Σb²).
-    let mut prefix = [[0u64; 4]; 9];
+    // prefix[i] = sums over order[..i]: (Σr, Σg, Σb, Σr²+Σg²+Σb²). At most 8 samples
+    // of 255: every sum and squared sum below fits u32 (and f32 exactly, < 2^24).
+    let mut prefix = [[0u32; 4]; 9];
     for (i, &k) in order.iter().enumerate() {
-        let c = samples[k].rgb.map(u64::from);
+        let c = samples[k].rgb.map(u32::from);
         let p = prefix[i];
         prefix[i + 1] = [
             p[0] + c[0],
@@ -302,29 +350,29 @@ fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph {
             p[3] + c[0] * c[0] + c[1] * c[1] + c[2] * c[2],
         ];
     }
-    let sse = |from: usize, to: usize| -> u64 {
-        let m = (to - from) as u64;
+    let sse = |from: usize, to: usize| -> u32 {
+        let m = (to - from) as u32;
         if m == 0 {
             return 0;
         }
         let (a, b) = (prefix[from], prefix[to]);
         let sq = b[3] - a[3];
-        let lin: u64 = (0..3).map(|c| (b[c] - a[c]).pow(2)).sum();
+        let lin: u32 = (0..3).map(|c| (b[c] - a[c]).pow(2)).sum();
         sq - lin / m
     };
     // Uncovered samples sort first and can only be background.
     let first_covered = order.iter().position(|&k| samples[k].covered).unwrap_or(n);
     // Σx² is the same for every split, so the split with the least squared error is
     // the one with the largest |S_a|²/a + |S_b|²/b (the between-group part). That is
-    // compared in f64 (two float divisions per split instead of two u64 divisions,
-    // which were most of the fit), and the integer error computed once at the end.
-    let norm2 = |p: &[u64; 4]| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) as f64;
+    // compared in f32 (no division per split: the old two u64 divisions per split
+    // were most of the fit), and the integer error computed once at the end.
+    let norm2 = |p: &[u32; 4]| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) as f32;
     let total = prefix[n];
     let mut split = first_covered;
-    let mut best = f64::NEG_INFINITY;
+    let mut best = f32::NEG_INFINITY;
     for (cut, a) in prefix.iter().enumerate().take(n).skip(first_covered) {
         let b = [total[0] - a[0], total[1] - a[1], total[2] - a[2], 0];
-        let part = |s: &[u64; 4], m: usize| if m == 0 { 0.0 } else { norm2(s) / m as f64 };
+        let part = |s: &[u32; 4], m: usize| norm2(s) * INV[m];
         let score = part(a, cut) + part(&b, n - cut);
         if score > best {
             (best, split) = (score, cut);
@@ -338,12 +386,28 @@ fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph {
         samples,
         dark.iter().copied().filter(|&i| samples[i].covered),
     );
-    let error = u32::try_from(best_err).unwrap_or(u32::MAX);
+    let error = best_err;
     CellGlyph {
         ch: mode.pattern_glyph(pattern),
         fg,
         bg,
         pattern,
         error,
+    }
+}
+
+#[cfg(test)]
+mod sort_tests {
+    use super::*;
+
+    /// By the zero-one principle a comparator network sorts every input if it sorts
+    /// every 0/1 input: all 256 of them.
+    #[test]
+    fn the_network_sorts_every_zero_one_input() {
+        for bits in 0u32..256 {
+            let mut k: [u32; 8] = std::array::from_fn(|i| bits >> i & 1);
+            sort8(&mut k);
+            assert!(k.windows(2).all(|w| w[0] <= w[1]), "{bits:08b} -> {k:?}");
+        }
     }
 }

@@ -17,7 +17,7 @@ pub mod wire;
 use glam::{Vec3, Vec4};
 
 use crate::counters::{self, Stage};
-use crate::raster::clip::{ClipOutcome, ClipVertex, classify, clip_triangle, guard_band_ndc};
+use crate::raster::clip::{ClipOutcome, ClipVertex, classify, clip_straddling, guard_band_ndc};
 use crate::raster::depth::{DepthBuffer, DepthFunc, DepthState};
 use crate::raster::interp::{
     Interpolation, Varying, perspective_weights, span_lerp, span_position,
@@ -226,12 +226,7 @@ impl<V: Varying> Prepared<V> {
     /// outside the triangle (the subdivided modes need them at span ends).
     #[inline(always)]
     fn persp_at(&self, x: u32, y: u32) -> [f32; 3] {
-        let s = &self.setup;
-        let (xi, yi) = (i64::from(x), i64::from(y));
-        let f01 = s.edge_raw(0, xi, yi);
-        let f02 = s.edge_raw(1, xi, yi);
-        let f = [f01, f02, s.area2 - f01 - f02];
-        perspective_weights(self.bary_of(f), self.inv_w).0
+        self.eval(x, y).persp
     }
 
     /// The interpolation weights of A, B, C at an evaluated pixel in `mode`.
@@ -328,10 +323,9 @@ pub fn prepare<V: Varying>(
         ClipOutcome::Rejected => return PrepareOutcome::Rejected,
         ClipOutcome::Inside => emit_piece(t, 0, clipped, tri, target, cull, emit, &mut seen),
         ClipOutcome::Clipped => {
-            let (outcome, poly) = clip_triangle(tri, guard);
-            if outcome == ClipOutcome::Rejected {
+            let Some(poly) = clip_straddling(tri, guard) else {
                 return PrepareOutcome::Rejected;
-            }
+            };
             for (i, tri) in poly.triangles().enumerate() {
                 emit_piece(t, i, clipped, tri, target, cull, emit, &mut seen);
             }

@@ -47,7 +47,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{EulerRot, Mat4, Quat, Vec3};
 
-use self::file::{EffectsFile, FogFile, LightKind, Lighting, MaterialFile, TextureMode};
+use self::file::{EffectsFile, LightKind, Lighting, MaterialFile, TextureMode};
 use self::plan::Plan;
 use self::texture::Texture;
 use crate::camera::Camera;
@@ -111,7 +111,7 @@ pub struct ObjectDesc {
     /// Unit axis and radians per second.
     pub spin: Option<(Vec3, f32)>,
     pub material: Material,
-    pub effects: Effects,
+    pub effects: EffectsFile,
 }
 
 impl ObjectDesc {
@@ -141,30 +141,6 @@ pub struct Material {
     /// A texture image given in the scene (else the model's map_Kd); a path ending
     /// in [`BUILTIN_CHECKER`] with no extension is the built-in checkerboard.
     pub image: Option<PathBuf>,
-}
-
-/// An object's effects.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Effects {
-    pub depth_test: bool,
-    pub cull: bool,
-    pub fog: Option<FogFile>,
-    pub depth_shading: bool,
-    pub wireframe: bool,
-    pub silhouette: bool,
-}
-
-impl From<&EffectsFile> for Effects {
-    fn from(e: &EffectsFile) -> Self {
-        Self {
-            depth_test: e.depth_test,
-            cull: e.cull,
-            fog: e.fog,
-            depth_shading: e.depth_shading,
-            wireframe: e.wireframe,
-            silhouette: e.silhouette,
-        }
-    }
 }
 
 impl From<(&MaterialFile, &Path)> for Material {
@@ -306,7 +282,7 @@ impl Scene {
                     .as_ref()
                     .map(|s| (Vec3::from(s.axis).normalize(), s.speed)),
                 material: Material::from((&o.material, path)),
-                effects: Effects::from(&o.effects),
+                effects: o.effects,
             })
             .collect();
         let plan = Plan::new(&descs, &lights, f.render.antialias);

@@ -92,19 +92,23 @@ pub fn sliver_fan(n: usize, w: u32, h: u32, seed: u64) -> Vec<Tri2> {
     let mut ts: Vec<f64> = (0..n).map(|_| r.range(0.0, perimeter)).collect();
     ts.extend([0.0, fw, fw + fh, 2.0 * fw + fh]);
     ts.sort_by(f64::total_cmp);
-    let point = |d: f64| {
-        let d = (d * 256.0).round() / 256.0;
-        if d <= fw {
-            [d, 0.0]
-        } else if d <= fw + fh {
-            [fw, d - fw]
-        } else if d <= 2.0 * fw + fh {
-            [fw - (d - fw - fh), fh]
-        } else {
-            [0.0, fh - (d - 2.0 * fw - fh)]
-        }
-    };
+    let point = |d: f64| perimeter_point((d * 256.0).round() / 256.0, fw, fh);
     (0..ts.len())
         .map(|i| [centre, point(ts[i]), point(ts[(i + 1) % ts.len()])])
         .collect()
+}
+
+/// The point at distance `d` along the border of `[0, w] × [0, h]`, clockwise on
+/// screen from the origin (top edge, right, bottom, left).
+#[must_use]
+pub fn perimeter_point(d: f64, w: f64, h: f64) -> [f64; 2] {
+    if d <= w {
+        [d, 0.0]
+    } else if d <= w + h {
+        [w, d - w]
+    } else if d <= 2.0 * w + h {
+        [w - (d - w - h), h]
+    } else {
+        [0.0, h - (d - 2.0 * w - h)]
+    }
 }

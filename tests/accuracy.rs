@@ -72,14 +72,17 @@ fn every_variant_is_measured_and_exact_ones_are_exact() {
     // More samples, less coverage error.
     let aa = summarize(&rows, Family::AntiAliasing, size);
     assert!(
-        aa[0].aa_mean > aa[1].aa_mean && aa[1].aa_mean > aa[2].aa_mean,
+        aa[0].errors.aa_mean > aa[1].errors.aa_mean && aa[1].errors.aa_mean > aa[2].errors.aa_mean,
         "{aa:?}"
     );
     // Perspective beats affine; reversed f32 depth fights no more than f32, unorm16 more.
     let interp = summarize(&rows, Family::Interpolation, size);
-    assert!(interp[1].attr_max_px < interp[0].attr_max_px);
+    assert!(interp[1].errors.attr_max_px < interp[0].errors.attr_max_px);
     let depth = summarize(&rows, Family::Depth, size);
-    assert!(depth[3].zfight <= depth[0].zfight && depth[2].zfight >= depth[0].zfight);
+    assert!(
+        depth[3].errors.zfight <= depth[0].errors.zfight
+            && depth[2].errors.zfight >= depth[0].errors.zfight
+    );
 }
 
 #[test]

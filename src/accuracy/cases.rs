@@ -5,7 +5,7 @@
 use super::edge::EdgeArith;
 use crate::raster::oracle;
 use crate::raster::{CountGrid, GUARD_BAND_PX, Target};
-use crate::workload::{Rng, Tri2, sliver_fan};
+use crate::workload::{Rng, Tri2, perimeter_point, sliver_fan};
 
 /// A named set of triangles on a target.
 #[derive(Clone, Debug)]
@@ -31,19 +31,7 @@ fn border(w: f64, h: f64, n: usize, rng: &mut Rng) -> Vec<[f64; 2]> {
     ts.extend([0.0, w, w + h, 2.0 * w + h]);
     ts.sort_by(f64::total_cmp);
     ts.dedup();
-    ts.into_iter()
-        .map(|d| {
-            if d <= w {
-                [d, 0.0]
-            } else if d <= w + h {
-                [w, d - w]
-            } else if d <= 2.0 * w + h {
-                [w - (d - w - h), h]
-            } else {
-                [0.0, h - (d - 2.0 * w - h)]
-            }
-        })
-        .collect()
+    ts.into_iter().map(|d| perimeter_point(d, w, h)).collect()
 }
 
 /// Every hard case, in suite order.

@@ -15,7 +15,7 @@ use ratatui::widgets::{Block, Widget};
 
 use crate::accuracy::cases::{self, HardCase};
 use crate::accuracy::edge::EdgeArith;
-use crate::accuracy::{Config, Family, Row, run};
+use crate::accuracy::{Config, Errors, Family, Row, run};
 use crate::raster::Target;
 
 /// Arguments of `termrast bench accuracy`.
@@ -65,16 +65,8 @@ pub struct Summary {
     pub ns: f64,
     pub triangles: u64,
     pub pixels: u64,
-    pub mismatches: Option<u64>,
-    pub holes: Option<u64>,
-    pub double_hits: Option<u64>,
-    pub attr_max: Option<f64>,
-    pub attr_mean: Option<f64>,
-    pub attr_max_px: Option<f64>,
-    pub attr_mean_px: Option<f64>,
-    pub aa_mean: Option<f64>,
-    pub aa_max: Option<f64>,
-    pub zfight: Option<f64>,
+    /// Summed counts, the largest maxima, and means averaged over the workloads.
+    pub errors: Errors,
 }
 
 impl Summary {
@@ -94,10 +86,10 @@ impl Summary {
     #[must_use]
     pub fn error(&self) -> f64 {
         match self.family {
-            Some(Family::Edge | Family::Traversal) => self.mismatches.unwrap_or(0) as f64,
-            Some(Family::Interpolation) => self.attr_max_px.unwrap_or(0.0),
-            Some(Family::AntiAliasing) => self.aa_mean.unwrap_or(0.0),
-            Some(Family::Depth) => self.zfight.unwrap_or(0.0),
+            Some(Family::Edge | Family::Traversal) => self.errors.mismatches.unwrap_or(0) as f64,
+            Some(Family::Interpolation) => self.errors.attr_max_px.unwrap_or(0.0),
+            Some(Family::AntiAliasing) => self.errors.aa_mean.unwrap_or(0.0),
+            Some(Family::Depth) => self.errors.zfight.unwrap_or(0.0),
             None => 0.0,
         }
     }
@@ -143,13 +135,14 @@ pub fn summarize(rows: &[Row], family: Family, size: Target) -> Vec<Summary> {
         s.ns += r.median_ns;
         s.triangles += r.triangles;
         s.pixels += r.pixels;
-        s.mismatches = add(s.mismatches, e.mismatches);
-        s.holes = add(s.holes, e.holes);
-        s.double_hits = add(s.double_hits, e.double_hits);
-        s.attr_max = max(s.attr_max, e.attr_max);
-        s.attr_max_px = max(s.attr_max_px, e.attr_max_px);
-        s.aa_max = max(s.aa_max, e.aa_max);
-        s.zfight = max(s.zfight, e.zfight);
+        let t = &mut s.errors;
+        t.mismatches = add(t.mismatches, e.mismatches);
+        t.holes = add(t.holes, e.holes);
+        t.double_hits = add(t.double_hits, e.double_hits);
+        t.attr_max = max(t.attr_max, e.attr_max);
+        t.attr_max_px = max(t.attr_max_px, e.attr_max_px);
+        t.aa_max = max(t.aa_max, e.aa_max);
+        t.zfight = max(t.zfight, e.zfight);
         // Means are averaged over the workloads that have them.
         for (m, v) in means[i]
             .iter_mut()
@@ -162,9 +155,9 @@ pub fn summarize(rows: &[Row], family: Family, size: Target) -> Vec<Summary> {
     }
     for (s, m) in out.iter_mut().zip(means) {
         let mean = |(sum, n): (f64, u32)| (n > 0).then(|| sum / f64::from(n));
-        s.attr_mean = mean(m[0]);
-        s.attr_mean_px = mean(m[1]);
-        s.aa_mean = mean(m[2]);
+        s.errors.attr_mean = mean(m[0]);
+        s.errors.attr_mean_px = mean(m[1]);
+        s.errors.aa_mean = mean(m[2]);
     }
     out
 }
@@ -211,26 +204,31 @@ pub fn report(rows: &[Row], config: &Config, hard: &[HardCase]) -> String {
                 Family::Edge | Family::Traversal => ("mismatches  holes  double hits", |m| {
                     format!(
                         "{:>10}  {:>5}  {:>11}",
-                        opt_u(m.mismatches),
-                        opt_u(m.holes),
-                        opt_u(m.double_hits)
+                        opt_u(m.errors.mismatches),
+                        opt_u(m.errors.holes),
+                        opt_u(m.errors.double_hits)
                     )
                 }),
                 Family::Interpolation => ("max err (px)  mean err (px)  max err (uv)", |m| {
                     format!(
                         "{:>12}  {:>13}  {:>12}",
-                        opt_e(m.attr_max_px),
-                        opt_e(m.attr_mean_px),
-                        opt_e(m.attr_max)
+                        opt_e(m.errors.attr_max_px),
+                        opt_e(m.errors.attr_mean_px),
+                        opt_e(m.errors.attr_max)
                     )
                 }),
                 Family::AntiAliasing => ("mean |cov−area|  max |cov−area|", |m| {
-                    format!("{:>15}  {:>14}", opt_e(m.aa_mean), opt_e(m.aa_max))
+                    format!(
+                        "{:>15}  {:>14}",
+                        opt_e(m.errors.aa_mean),
+                        opt_e(m.errors.aa_max)
+                    )
                 }),
                 Family::Depth => ("z-fighting", |m| {
                     format!(
                         "{:>10}",
-                        m.zfight
+                        m.errors
+                            .zfight
                             .map_or_else(|| "—".into(), |z| format!("{:.3}%", z * 100.0))
                     )
                 }),

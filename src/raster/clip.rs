@@ -29,6 +29,15 @@ pub struct Polygon<V> {
 }
 
 impl<V: Copy> Polygon<V> {
+    /// The triangle itself, unclipped.
+    #[must_use]
+    pub fn of(tri: [ClipVertex<V>; 3]) -> Self {
+        let mut verts = [tri[0]; MAX_CLIPPED];
+        verts[1] = tri[1];
+        verts[2] = tri[2];
+        Self { verts, len: 3 }
+    }
+
     /// The vertices.
     #[must_use]
     pub fn vertices(&self) -> &[ClipVertex<V>] {
@@ -99,16 +108,19 @@ pub fn clip_triangle<V: Varying>(
     tri: [ClipVertex<V>; 3],
     guard: [f32; 2],
 ) -> (ClipOutcome, Polygon<V>) {
-    let mut poly = Polygon {
-        verts: [tri[0]; MAX_CLIPPED],
-        len: 3,
-    };
-    poly.verts[1] = tri[1];
-    poly.verts[2] = tri[2];
-    let outcome = classify(&tri, guard);
-    if outcome != ClipOutcome::Clipped {
-        return (outcome, poly);
+    match classify(&tri, guard) {
+        ClipOutcome::Clipped => match clip_straddling(tri, guard) {
+            Some(poly) => (ClipOutcome::Clipped, poly),
+            None => (ClipOutcome::Rejected, Polygon::of(tri)),
+        },
+        outcome => (outcome, Polygon::of(tri)),
     }
+}
+
+/// Clips a triangle that [`classify`] found `Clipped` (it crosses a plane and no
+/// plane rejects it); `None` when nothing with w > 0 is left.
+pub fn clip_straddling<V: Varying>(tri: [ClipVertex<V>; 3], guard: [f32; 2]) -> Option<Polygon<V>> {
+    let mut poly = Polygon::of(tri);
     for plane in 0..6 {
         let mut out = Polygon {
             verts: poly.verts,
@@ -131,7 +143,7 @@ pub fn clip_triangle<V: Varying>(
         }
         poly = out;
         if poly.len < 3 {
-            return (ClipOutcome::Rejected, poly);
+            return None;
         }
     }
     if poly
@@ -139,9 +151,9 @@ pub fn clip_triangle<V: Varying>(
         .iter()
         .any(|v| !v.pos.is_finite() || v.pos.w <= 0.0)
     {
-        return (ClipOutcome::Rejected, poly);
+        return None;
     }
-    (ClipOutcome::Clipped, poly)
+    Some(poly)
 }
 
 /// Where edge a→b crosses a plane, given the signed distances of its ends (one ≥ 0,

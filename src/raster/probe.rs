@@ -40,6 +40,23 @@ pub struct ProbeRecord<V> {
     pub varying: V,
 }
 
+impl<V> ProbeRecord<V> {
+    /// The same record with its varyings replaced by `f(varying)`.
+    #[must_use]
+    pub fn map<U>(self, f: impl FnOnce(V) -> U) -> ProbeRecord<U> {
+        ProbeRecord {
+            triangle: self.triangle,
+            piece: self.piece,
+            clipped: self.clipped,
+            setup: self.setup,
+            eval: self.eval,
+            depth: self.depth,
+            block: self.block,
+            varying: f(self.varying),
+        }
+    }
+}
+
 /// Everything the probe found at a pixel, in draw order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Probe<V> {

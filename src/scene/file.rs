@@ -220,7 +220,7 @@ impl Default for MaterialFile {
 }
 
 /// `[object.effects]`.
-#[derive(Debug, Default, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct EffectsFile {
     pub depth_test: bool,

@@ -88,7 +88,6 @@ pub struct FrameCtx<'a> {
     pub lights: &'a [LightDesc],
     /// View depths mapped to bright and dark by depth shading.
     pub depth_range: (f32, f32),
-    pub target: Target,
     pub time: f32,
 }
 
@@ -419,28 +418,24 @@ where
         y: u32,
         stored: f32,
     ) -> Probe<()> {
-        // Probe on positions only: coverage, barycentrics and depth do not depend on
-        // the varyings.
-        let positions = VertexCache {
-            verts: self
-                .cache
-                .verts
-                .iter()
-                .map(|v| crate::raster::clip::ClipVertex {
-                    pos: v.pos,
-                    var: (),
-                })
-                .collect(),
-        };
-        probe_from(
-            &positions,
+        // The trait object cannot return this pipeline's varying type: the records keep
+        // everything else.
+        let p = probe_from(
+            &self.cache,
             &obj.mesh.indices,
             target,
             &draw_options(plan),
             x,
             y,
             stored,
-        )
+        );
+        Probe {
+            x: p.x,
+            y: p.y,
+            records: p.records.into_iter().map(|r| r.map(|_| ())).collect(),
+            winner: p.winner,
+            final_depth: p.final_depth,
+        }
     }
 
     fn varyings(&self) -> VaryingSet {
@@ -522,15 +517,11 @@ pub struct SceneFrame {
     /// Counters of the last frame, all objects.
     pub stats: DrawStats,
     pub wire_pixels: u64,
-    /// The size the frame was drawn at and the camera used.
-    pub target: Target,
-    pub ctx_view_proj: Mat4,
 }
 
 impl std::fmt::Debug for SceneFrame {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SceneFrame")
-            .field("target", &self.target)
             .field("stats", &self.stats)
             .finish_non_exhaustive()
     }
@@ -553,8 +544,6 @@ impl SceneFrame {
             silhouettes: Vec::new(),
             stats: DrawStats::default(),
             wire_pixels: 0,
-            target: Target::new(1, 1),
-            ctx_view_proj: Mat4::IDENTITY,
         }
     }
 
@@ -607,7 +596,6 @@ impl SceneFrame {
             forward,
             lights: &scene.lights,
             depth_range,
-            target: fine,
             time: view.time,
         };
         let color = if side > 1 {
@@ -653,8 +641,6 @@ impl SceneFrame {
             );
         }
         self.stats = stats;
-        self.target = target;
-        self.ctx_view_proj = view_proj;
     }
 
     /// Probes sample `(x, y)` of the last frame (without supersampling) for every

@@ -245,3 +245,51 @@ fn minimal_and_default_scenes() {
     let o = &default.plan.objects[0];
     assert!(o.depth_test && o.varyings.normal && default.plan.depth_buffer);
 }
+
+/// Pass: the binary prints a scene's plan, and refuses a bad scene with its message
+/// and a non-zero exit, not a panic.
+#[test]
+fn render_plan_and_bad_scene_from_the_command_line() {
+    let bin = env!("CARGO_BIN_EXE_termrast");
+    let minimal = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/minimal.toml");
+    let out = std::process::Command::new(bin)
+        .args(["render", minimal.to_str().unwrap(), "--plan"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("depth buffer: skipped") && text.contains("normals: skipped (no lighting)"),
+        "{text}"
+    );
+    let dir = std::env::temp_dir().join(format!("termrast-bad-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.toml");
+    std::fs::write(
+        &bad,
+        "[[object]]\nmodel = \"teapot\"\n[object.effects]\nfog = { start = 5, end = 1 }\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(bin)
+        .args([
+            "render",
+            bad.to_str().unwrap(),
+            "--cols",
+            "20",
+            "--rows",
+            "6",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("bad.toml:4") && err.contains("fog") && !err.contains("panicked"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -275,3 +275,21 @@ pub fn edge_glyph(dx: f32, dy: f32) -> char {
         _ => '\\',
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::edge_glyph;
+
+    #[test]
+    fn edge_glyphs_follow_the_direction_on_screen() {
+        // y is down on screen: (1, -1) rises to the right.
+        assert_eq!(edge_glyph(1.0, 0.0), '_');
+        assert_eq!(edge_glyph(-1.0, 0.1), '_');
+        assert_eq!(edge_glyph(0.0, 1.0), '|');
+        assert_eq!(edge_glyph(0.1, -1.0), '|');
+        assert_eq!(edge_glyph(1.0, -1.0), '/');
+        assert_eq!(edge_glyph(-1.0, 1.0), '/');
+        assert_eq!(edge_glyph(1.0, 1.0), '\\');
+        assert_eq!(edge_glyph(-1.0, -1.0), '\\');
+    }
+}

@@ -11,6 +11,7 @@ pub mod mesh;
 pub mod raster;
 pub mod render;
 pub mod scene;
+pub mod simd;
 pub mod terminal;
 pub mod tui;
 pub mod workload;

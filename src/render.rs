@@ -14,6 +14,8 @@ pub mod standard;
 pub mod target;
 pub mod wire;
 
+use std::marker::PhantomData;
+
 use glam::{Vec3, Vec4};
 
 use crate::counters::{self, Stage};
@@ -23,8 +25,8 @@ use crate::raster::interp::{
     Interpolation, Varying, perspective_weights, span_lerp, span_position,
 };
 use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup, Target, Traversal, map3};
-pub use target::{ColorTarget, Luma, Rgba8, lanes_of};
-use wide::{f32x8, i32x8};
+use crate::simd::{F32s, I32s, each3};
+pub use target::{ColorTarget, Luma, Rgba8};
 
 /// A shader: the vertex stage produces clip-space positions and varyings for vertex
 /// indices, the fragment stage a linear RGB colour from interpolated varyings. The
@@ -39,11 +41,11 @@ pub trait Shader {
     /// Colours of up to 8 fragments of one triangle at once, as red, green and blue
     /// lanes: lane `k` (for each set bit of `mask`) has weights `w[..][k]` for the vertex
     /// varyings `var`. The default interpolates and shades lane by lane; shaders
-    /// override it with `f32x8` code that must give the same bits as
+    /// override it with 8-lane code that must give the same bits as
     /// [`Shader::fragment`] (the probe relies on it).
     #[inline(always)]
-    fn fragment8(&self, var: &[Self::Varying; 3], w: &[f32x8; 3], mask: u8) -> [f32x8; 3] {
-        let w = w.map(f32x8::to_array);
+    fn fragment8<F: F32s>(&self, var: &[Self::Varying; 3], w: &[F; 3], mask: u8) -> [F; 3] {
+        let w = each3!(|i| w[i].to_array());
         let mut out = [[0f32; 8]; 3];
         let mut m = mask;
         while m != 0 {
@@ -53,7 +55,7 @@ pub trait Shader {
             (out[0][k], out[1][k], out[2][k]) = (c.x, c.y, c.z);
             m &= m - 1;
         }
-        out.map(f32x8::new)
+        each3!(|i| F::from_array(out[i]))
     }
 }
 
@@ -157,8 +159,8 @@ fn edge_value(g: f32, rem: f32) -> f32 {
 
 /// [`edge_value`] on 8 lanes.
 #[inline(always)]
-fn edge_value8(g: f32x8, rem: f32) -> f32x8 {
-    g * f32x8::splat(256.0) + f32x8::splat(rem)
+fn edge_value8<F: F32s>(g: F, rem: f32) -> F {
+    g * F::splat(256.0) + F::splat(rem)
 }
 
 /// The state of one pixel of one triangle: what the renderer computes per fragment.
@@ -424,7 +426,7 @@ fn setup_piece<V: Varying>(
 }
 
 /// The fragment loop of one triangle: receives coverage from the traversal.
-struct Fragments<'a, S: Shader, C> {
+struct Fragments<'a, S: Shader, C, L> {
     tri: &'a Prepared<S::Varying>,
     shader: &'a S,
     depth: &'a mut DepthBuffer,
@@ -433,9 +435,11 @@ struct Fragments<'a, S: Shader, C> {
     width: usize,
     fragments: u64,
     shaded: u64,
+    /// The SIMD backend of the lanes this loop builds itself (see [`Fragments::mask8`]).
+    lanes: PhantomData<L>,
 }
 
-impl<S: Shader, C: ColorTarget> CoverageSink for Fragments<'_, S, C> {
+impl<S: Shader, C: ColorTarget, L: I32s> CoverageSink for Fragments<'_, S, C, L> {
     #[inline(always)]
     fn pixel(&mut self, x: u32, y: u32) {
         let e = self.tri.eval(x, y);
@@ -466,9 +470,9 @@ impl<S: Shader, C: ColorTarget> CoverageSink for Fragments<'_, S, C> {
         }
         let s = &self.tri.setup;
         let (xi, yi) = (i64::from(x0), i64::from(y));
-        let g = map3([0, 1, 2], |e| {
+        let g = each3!(|e| {
             let base = s.reduced_edge(e, xi, yi);
-            f32x8::new(std::array::from_fn(|k| (base + k as i64 * s.i[e]) as f32))
+            L::F::from_array(std::array::from_fn(|k| (base + k as i64 * s.i[e]) as f32))
         });
         self.shade8(y, x0, mask, g);
     }
@@ -476,16 +480,16 @@ impl<S: Shader, C: ColorTarget> CoverageSink for Fragments<'_, S, C> {
     /// Eight aligned pixels with the `wide` traversal's `i32x8` edge lanes: one
     /// conversion per edge gives the exact edge values.
     #[inline(always)]
-    fn edges8(&mut self, y: u32, x0: u32, mask: u8, g: &[i32x8; 3]) {
+    fn edges8<G: I32s>(&mut self, y: u32, x0: u32, mask: u8, g: &[G; 3]) {
         if x0 as usize + 8 > self.width {
             self.pixels(y, x0, mask);
             return;
         }
-        self.shade8(y, x0, mask, map3(*g, i32x8::round_float));
+        self.shade8(y, x0, mask, each3!(|e| g[e].to_f32()));
     }
 }
 
-impl<S: Shader, C: ColorTarget> Fragments<'_, S, C> {
+impl<S: Shader, C: ColorTarget, L: I32s> Fragments<'_, S, C, L> {
     /// The last group of a row whose width is not a multiple of 8, pixel by pixel.
     #[inline(never)]
     fn pixels(&mut self, y: u32, x0: u32, mask: u8) {
@@ -497,16 +501,16 @@ impl<S: Shader, C: ColorTarget> Fragments<'_, S, C> {
     }
 
     /// Barycentrics, depth, the depth test and perspective weights of eight pixels in
-    /// `f32x8` from their reduced edge values `g` (as floats); shading runs on the lanes
+    /// 8 lanes from their reduced edge values `g` (as floats); shading runs on the lanes
     /// that pass. The same operations in the same order as [`Prepared::eval`].
     #[inline(always)]
-    fn shade8(&mut self, y: u32, x0: u32, mask: u8, g: [f32x8; 3]) {
+    fn shade8<F: F32s>(&mut self, y: u32, x0: u32, mask: u8, g: [F; 3]) {
         let t = self.tri;
         let start = y as usize * self.width + x0 as usize;
-        let fl = map3([0, 1, 2], |e| edge_value8(g[e], t.edge_rem[e]));
-        let ia = f32x8::splat(t.inv_area2);
+        let fl = each3!(|e| edge_value8(g[e], t.edge_rem[e]));
+        let ia = F::splat(t.inv_area2);
         let b = [fl[1] * ia, fl[2] * ia, fl[0] * ia];
-        let z = map3(t.z, f32x8::splat);
+        let z = each3!(|e| F::splat(t.z[e]));
         let depth = b[0] * z[0] + b[1] * z[1] + b[2] * z[2];
         self.fragments += u64::from(mask.count_ones());
         let pass = if self.opts.depth.uses_buffer() {
@@ -514,17 +518,16 @@ impl<S: Shader, C: ColorTarget> Fragments<'_, S, C> {
             let slot: &mut [f32; 8] = (&mut self.depth.data[start..start + 8])
                 .try_into()
                 .expect("8 lanes");
-            let old = f32x8::new(*slot);
+            let old = F::from_array(*slot);
             let test = match self.opts.depth.func {
-                DepthFunc::Less => depth.simd_lt(old).to_bitmask() as u8,
-                DepthFunc::LessEqual => depth.simd_le(old).to_bitmask() as u8,
+                DepthFunc::Less => depth.lt(old).bitmask(),
+                DepthFunc::LessEqual => depth.le(old).bitmask(),
                 DepthFunc::Always => !0,
             };
             let pass = test & mask;
             if pass != 0 && self.opts.depth.write {
-                *slot = bytemuck::cast::<_, f32x8>(lanes_of(pass))
-                    .select(depth, old)
-                    .to_array();
+                let keep = F::I::from_bits(pass).cast_f32();
+                *slot = F::select(keep, depth, old).to_array();
             }
             pass
         } else {
@@ -535,9 +538,9 @@ impl<S: Shader, C: ColorTarget> Fragments<'_, S, C> {
         }
         let w = match self.opts.interpolation {
             Interpolation::Perspective => {
-                let iw = map3(t.inv_w, f32x8::splat);
+                let iw = each3!(|e| F::splat(t.inv_w[e]));
                 let p = [b[0] * iw[0], b[1] * iw[1], b[2] * iw[2]];
-                let r = f32x8::splat(1.0) / (p[0] + p[1] + p[2]);
+                let r = F::splat(1.0) / (p[0] + p[1] + p[2]);
                 [p[0] * r, p[1] * r, p[2] * r]
             }
             Interpolation::Affine => b,
@@ -553,7 +556,7 @@ impl<S: Shader, C: ColorTarget> Fragments<'_, S, C> {
 /// at the ends of each pixel's span (computed once per distinct span end), linear in
 /// between, by the same operations as [`Prepared::weights`].
 #[inline(always)]
-fn span_weights8<V: Varying>(t: &Prepared<V>, n: u32, x0: u32, y: u32) -> [f32x8; 3] {
+fn span_weights8<V: Varying, F: F32s>(t: &Prepared<V>, n: u32, x0: u32, y: u32) -> [F; 3] {
     let mut out = [[0f32; 8]; 3];
     let mut ends = (u32::MAX, [0f32; 3], [0f32; 3]);
     for k in 0..8 {
@@ -566,20 +569,21 @@ fn span_weights8<V: Varying>(t: &Prepared<V>, n: u32, x0: u32, y: u32) -> [f32x8
             out[v][k as usize] = w[v];
         }
     }
-    out.map(f32x8::new)
+    each3!(|i| F::from_array(out[i]))
 }
 
 /// Rasterizes the pieces of a draw's triangles.
-struct Raster<'a, S, C> {
+struct Raster<'a, S, C, L> {
     shader: &'a S,
     depth: &'a mut DepthBuffer,
     color: &'a mut C,
     opts: DrawOptions,
     width: usize,
     stats: DrawStats,
+    lanes: PhantomData<L>,
 }
 
-impl<S: Shader, C: ColorTarget> EmitPiece<S::Varying> for Raster<'_, S, C> {
+impl<S: Shader, C: ColorTarget, L: I32s> EmitPiece<S::Varying> for Raster<'_, S, C, L> {
     #[inline(always)]
     fn piece(&mut self, tri: &Prepared<S::Varying>) {
         let mut frag = Fragments {
@@ -591,8 +595,9 @@ impl<S: Shader, C: ColorTarget> EmitPiece<S::Varying> for Raster<'_, S, C> {
             width: self.width,
             fragments: 0,
             shaded: 0,
+            lanes: PhantomData::<L>,
         };
-        self.opts.traversal.run(&tri.setup, &mut frag);
+        self.opts.traversal.run_lanes::<L, _>(&tri.setup, &mut frag);
         self.stats.fragments += frag.fragments;
         self.stats.shaded += frag.shaded;
     }
@@ -697,13 +702,13 @@ impl Renderer {
             unsafe { self.draw_avx2(shader, cache, indices, opts, color) };
             return;
         }
-        self.draw_triangles(shader, cache, indices, opts, color);
+        self.draw_triangles::<_, _, wide::i32x8>(shader, cache, indices, opts, color);
     }
 
-    /// The draw loop compiled with AVX2 enabled, so the 8-lane types run as one
-    /// 256-bit register instead of two 128-bit halves. Only the instruction
-    /// selection differs: no operation is fused or reordered, so the output is
-    /// bit-identical to the baseline path (the tests compare both).
+    /// The draw loop compiled with AVX2 enabled and on [`crate::simd`]'s AVX2 lanes,
+    /// so 8-lane values are one 256-bit register instead of two 128-bit halves. Only
+    /// the instruction selection differs: no operation is fused or reordered, so the
+    /// output is bit-identical to the baseline path (the tests compare both).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn draw_avx2<S: Shader, C: ColorTarget>(
@@ -714,11 +719,11 @@ impl Renderer {
         opts: &DrawOptions,
         color: &mut C,
     ) {
-        self.draw_triangles(shader, cache, indices, opts, color);
+        self.draw_triangles::<_, _, crate::simd::avx2::I32x8>(shader, cache, indices, opts, color);
     }
 
     #[inline(always)]
-    fn draw_triangles<S: Shader, C: ColorTarget>(
+    fn draw_triangles<S: Shader, C: ColorTarget, L: I32s>(
         &mut self,
         shader: &S,
         cache: &VertexCache<S::Varying>,
@@ -734,6 +739,7 @@ impl Renderer {
             opts: *opts,
             width: target.width as usize,
             stats: DrawStats::default(),
+            lanes: PhantomData::<L>,
         };
         let n = (indices.len() / 3) as u32;
         for t in 0..n {

@@ -5,7 +5,7 @@
 //! masks (`wide`). Sinks are generic parameters, so each traversal is monomorphized
 //! for its sink and nothing is dispatched per pixel.
 
-use wide::i32x8;
+use crate::simd::I32s;
 
 /// Receives the pixels a traversal covers. Every pixel reported lies inside the
 /// target and the triangle's bounding box.
@@ -38,7 +38,7 @@ pub trait CoverageSink {
     /// fragment stage) takes them from here instead of recomputing eight of them per
     /// edge; lanes outside `mask` hold values too but are not covered.
     #[inline]
-    fn edges8(&mut self, y: u32, x0: u32, mask: u8, g: &[i32x8; 3]) {
+    fn edges8<L: I32s>(&mut self, y: u32, x0: u32, mask: u8, g: &[L; 3]) {
         let _ = g;
         self.mask8(y, x0, mask);
     }

@@ -16,9 +16,10 @@ mod wide;
 pub use block::{BlockClass, DEFAULT_BLOCK, block, block_containing, classify_block};
 pub use scalar::scalar;
 pub use seed_simd::{SeedLanes, seed_simd, seed_simd_lanes};
-pub use wide::{fits_i32, wide};
+pub use wide::{fits_i32, wide, wide_lanes};
 
 use super::{CoverageSink, Setup};
+use crate::simd::I32s;
 
 /// Which traversal to run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
@@ -56,11 +57,17 @@ impl Traversal {
     /// Runs this traversal over one triangle. The match happens once per triangle.
     #[inline(always)]
     pub fn run<S: CoverageSink>(self, setup: &Setup, sink: &mut S) {
+        self.run_lanes::<::wide::i32x8, S>(setup, sink);
+    }
+
+    /// [`Traversal::run`] with `wide`'s lanes of backend `L` (see [`crate::simd`]).
+    #[inline(always)]
+    pub fn run_lanes<L: I32s, S: CoverageSink>(self, setup: &Setup, sink: &mut S) {
         match self {
             Traversal::Scalar => scalar(setup, sink),
             Traversal::SeedSimd => seed_simd(setup, sink),
             Traversal::Block => block(setup, DEFAULT_BLOCK, sink),
-            Traversal::Wide => wide(setup, sink),
+            Traversal::Wide => wide_lanes::<L, S>(setup, sink),
         }
     }
 }

@@ -1,11 +1,10 @@
 //! Ready-made shaders over a [`Mesh`].
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
-use wide::f32x8;
 
 use super::Shader;
 use crate::mesh::Mesh;
-use crate::raster::map3;
+use crate::simd::{F32s, each3};
 
 /// The standard light direction (towards the light, world space), normalised.
 #[must_use]
@@ -67,22 +66,23 @@ impl Shader for Lambert<'_> {
     }
 
     #[inline(always)]
-    fn fragment8(&self, var: &[Vec3; 3], w: &[f32x8; 3], _mask: u8) -> [f32x8; 3] {
+    fn fragment8<F: F32s>(&self, var: &[Vec3; 3], w: &[F; 3], _mask: u8) -> [F; 3] {
         // `Varying::weighted` lane by lane: a + (b − a)·w1 + (c − a)·w2.
-        let c = |a: f32, b: f32, c: f32| {
-            f32x8::splat(a) + f32x8::splat(b - a) * w[1] + f32x8::splat(c - a) * w[2]
-        };
         let [p, q, r] = var;
-        let (x, y, z) = (c(p.x, q.x, r.x), c(p.y, q.y, r.y), c(p.z, q.z, r.z));
+        let [x, y, z] = each3!(|i| {
+            let (a, b, c) = (p[i], q[i], r[i]);
+            F::splat(a) + F::splat(b - a) * w[1] + F::splat(c - a) * w[2]
+        });
         let len = (x * x + y * y + z * z).sqrt();
         let lt = self.light;
-        let d = x * f32x8::splat(lt.x) + y * f32x8::splat(lt.y) + z * f32x8::splat(lt.z);
+        let d = x * F::splat(lt.x) + y * F::splat(lt.y) + z * F::splat(lt.z);
         let l = d / len;
         // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
-        let l = l.simd_gt(f32x8::ZERO).select(l, f32x8::ZERO);
-        let a = f32x8::splat(self.ambient);
-        let k = a + (f32x8::splat(1.0) - a) * l;
-        map3(self.base.to_array(), |c| f32x8::splat(c) * k)
+        let zero = F::splat(0.0);
+        let l = F::select(l.gt(zero), l, zero);
+        let a = F::splat(self.ambient);
+        let k = a + (F::splat(1.0) - a) * l;
+        each3!(|i| F::splat(self.base[i]) * k)
     }
 }
 

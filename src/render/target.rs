@@ -2,8 +2,7 @@
 
 use glam::Vec3;
 
-use crate::raster::map3;
-use wide::{f32x8, i32x8};
+use crate::simd::{F32s, I32s, each3};
 
 /// A framebuffer a draw writes shaded fragments into. Generic so the write is
 /// inlined into the fragment loop.
@@ -16,8 +15,8 @@ pub trait ColorTarget {
     /// Writes colour lane `k` (red, green, blue lanes) to pixel `start + k` for each
     /// set bit `k` of `mask`; must store what [`ColorTarget::put`] would.
     #[inline(always)]
-    fn put8(&mut self, start: usize, mask: u8, c: &[f32x8; 3]) {
-        let c = c.map(f32x8::to_array);
+    fn put8<F: F32s>(&mut self, start: usize, mask: u8, c: &[F; 3]) {
+        let c = each3!(|i| c[i].to_array());
         let mut m = mask;
         while m != 0 {
             let k = m.trailing_zeros() as usize;
@@ -43,19 +42,11 @@ pub fn to_u8(v: f32) -> u8 {
 /// [`to_u8`] on 8 lanes, bit for bit (NaN gives 0 in both).
 #[must_use]
 #[inline(always)]
-pub fn to_u8x8(v: f32x8) -> i32x8 {
-    let zero = f32x8::ZERO;
-    let v = v.simd_gt(zero).select(v, zero);
-    let v = v.simd_lt(f32x8::ONE).select(v, f32x8::ONE);
-    (v * f32x8::splat(255.0) + f32x8::splat(0.5)).trunc_int()
-}
-
-/// Lane `k` is all ones when bit `k` of `mask` is set, else zero: a mask for `select`.
-#[must_use]
-#[inline(always)]
-pub fn lanes_of(mask: u8) -> i32x8 {
-    let bits = i32x8::new([1, 2, 4, 8, 16, 32, 64, 128]);
-    (i32x8::splat(i32::from(mask)) & bits).simd_eq(bits)
+pub fn to_u8x8<F: F32s>(v: F) -> F::I {
+    let (zero, one) = (F::splat(0.0), F::splat(1.0));
+    let v = F::select(v.gt(zero), v, zero);
+    let v = F::select(v.lt(one), v, one);
+    (v * F::splat(255.0) + F::splat(0.5)).trunc_i32()
 }
 
 impl ColorTarget for Rgba8 {
@@ -64,14 +55,14 @@ impl ColorTarget for Rgba8 {
         self.0[index] = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255];
     }
     #[inline(always)]
-    fn put8(&mut self, start: usize, mask: u8, c: &[f32x8; 3]) {
+    fn put8<F: F32s>(&mut self, start: usize, mask: u8, c: &[F; 3]) {
         // Pack to little-endian RGBA words and blend all 8 pixels in one store.
-        let [r, g, b] = map3(*c, to_u8x8);
-        let px = r | (g << 8) | (b << 16) | i32x8::splat(0xFF << 24);
+        let [r, g, b] = each3!(|i| to_u8x8(c[i]));
+        let px = r | g.shl::<8>() | b.shl::<16>() | F::I::splat(0xFF << 24);
         let dst: &mut [i32; 8] = bytemuck::cast_slice_mut(&mut self.0[start..start + 8])
             .try_into()
             .expect("8 pixels");
-        *dst = lanes_of(mask).select(px, i32x8::new(*dst)).to_array();
+        *dst = F::I::select(F::I::from_bits(mask), px, F::I::from_array(*dst)).to_array();
     }
     fn reset(&mut self, len: usize, c: Vec3) {
         let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0];
@@ -110,7 +101,7 @@ impl<A: ColorTarget, B: ColorTarget> ColorTarget for (A, B) {
         self.1.put(index, c);
     }
     #[inline(always)]
-    fn put8(&mut self, start: usize, mask: u8, c: &[f32x8; 3]) {
+    fn put8<F: F32s>(&mut self, start: usize, mask: u8, c: &[F; 3]) {
         self.0.put8(start, mask, c);
         self.1.put8(start, mask, c);
     }

@@ -1,6 +1,7 @@
 use wide::{i32x8, i64x4};
 
-use crate::raster::{CoverageSink, Setup, map3};
+use crate::raster::{CoverageSink, Setup};
+use crate::simd::{I32s, each3};
 
 /// 8 lanes of edge values, one per pixel of a row group.
 trait Lanes: Copy {
@@ -14,15 +15,15 @@ trait Lanes: Copy {
     fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u8, f: &[Self; 3]);
 }
 
-impl Lanes for i32x8 {
+impl<L: I32s> Lanes for L {
     #[inline(always)]
     fn ramp(base: i64, step: i64) -> Self {
         // Exact: `fits_i32` bounded every lane value before this path was chosen.
-        i32x8::new(std::array::from_fn(|i| (base + i as i64 * step) as i32))
+        L::from_array(std::array::from_fn(|i| (base + i as i64 * step) as i32))
     }
     #[inline(always)]
     fn splat(v: i64) -> Self {
-        i32x8::splat(v as i32)
+        L::splat(v as i32)
     }
     #[inline(always)]
     fn add(self, o: Self) -> Self {
@@ -31,7 +32,7 @@ impl Lanes for i32x8 {
     #[inline(always)]
     fn inside_mask(a: Self, b: Self, c: Self) -> u8 {
         // The OR of three values is negative iff one of them is: one sign-bit mask.
-        !((a | b | c).to_bitmask() as u8)
+        !(a | b | c).bitmask()
     }
     #[inline(always)]
     fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u8, f: &[Self; 3]) {
@@ -105,8 +106,15 @@ pub fn fits_i32(s: &Setup) -> bool {
 /// `i64x4`.
 #[inline(always)]
 pub fn wide<S: CoverageSink>(s: &Setup, sink: &mut S) {
+    wide_lanes::<i32x8, S>(s, sink);
+}
+
+/// [`wide`] on the `i32` lanes of backend `L` (see [`crate::simd`]): identical
+/// coverage and edge values, different instructions.
+#[inline(always)]
+pub fn wide_lanes<L: I32s, S: CoverageSink>(s: &Setup, sink: &mut S) {
     if fits_i32(s) {
-        walk::<i32x8, S>(s, sink);
+        walk::<L, S>(s, sink);
     } else {
         walk::<Lanes64, S>(s, sink);
     }
@@ -138,9 +146,9 @@ fn row_range(f: [i64; 3], sx: [i64; 3], x0: u32, x1: u32) -> Option<(u32, u32)> 
 fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
     let b = s.bbox;
     let (mut row, sx, sy) = reduced(s);
-    let step8 = sx.map(|v| L::splat(v * 8));
+    let step8 = each3!(|e| L::splat(sx[e] * 8));
     // Lane offsets `i·sx`, built once per triangle; a row start is one splat and add.
-    let ramp = sx.map(|v| L::ramp(0, v));
+    let ramp = each3!(|e| L::ramp(0, sx[e]));
     // Boxes of two groups or fewer gain nothing from the per-row range.
     let narrow = b.width() <= 16;
     for y in b.y0..=b.y1 {
@@ -154,7 +162,7 @@ fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
             // a group's mask as one byte. Lanes left of the box are masked off.
             let mut x = lo & !7;
             let skip = i64::from(x) - i64::from(b.x0);
-            let mut f = map3([0, 1, 2], |e| L::splat(row[e] + skip * sx[e]).add(ramp[e]));
+            let mut f = each3!(|e| L::splat(row[e] + skip * sx[e]).add(ramp[e]));
             let mut first = !0u8 << b.x0.saturating_sub(x).min(7);
             loop {
                 let mut m = L::inside_mask(f[0], f[1], f[2]) & first;

@@ -268,30 +268,6 @@ pub fn fit_cell(mode: GlyphMode, samples: &[Sample], colorless: bool) -> CellGly
     }
 }
 
-/// The 19 compare-exchanges of an optimal sorting network for 8 elements: branch-free,
-/// where a general sort of 8 keys per cell was a tenth of the glyph fit.
-const SORT8: [(usize, usize); 19] = [
-    (0, 2),
-    (1, 3),
-    (4, 6),
-    (5, 7),
-    (0, 4),
-    (1, 5),
-    (2, 6),
-    (3, 7),
-    (0, 1),
-    (2, 3),
-    (4, 5),
-    (6, 7),
-    (2, 4),
-    (3, 5),
-    (1, 4),
-    (3, 6),
-    (1, 2),
-    (3, 4),
-    (5, 6),
-];
-
 /// `1/m` for group sizes 0..=8 (0 for an empty group, whose sum is 0 anyway).
 const INV: [f32; 9] = [
     0.0,
@@ -305,14 +281,42 @@ const INV: [f32; 9] = [
     1.0 / 8.0,
 ];
 
-/// Sorts 8 keys ascending.
+/// Sorts 8 keys ascending by the 19 compare-exchanges of an optimal sorting network:
+/// branch-free, where a general sort of 8 keys per cell was a tenth of the glyph fit.
+/// Written out so every index is a constant and the keys stay in registers (a loop over
+/// a table of pairs went through memory at every exchange).
 #[inline]
 fn sort8(k: &mut [u32; 8]) {
-    for (i, j) in SORT8 {
-        let (a, b) = (k[i], k[j]);
-        k[i] = a.min(b);
-        k[j] = a.max(b);
+    macro_rules! exchange {
+        ($(($i:literal, $j:literal)),* $(,)?) => {
+            $(
+                let (a, b) = (k[$i], k[$j]);
+                k[$i] = a.min(b);
+                k[$j] = a.max(b);
+            )*
+        };
     }
+    exchange!(
+        (0, 2),
+        (1, 3),
+        (4, 6),
+        (5, 7),
+        (0, 4),
+        (1, 5),
+        (2, 6),
+        (3, 7),
+        (0, 1),
+        (2, 3),
+        (4, 5),
+        (6, 7),
+        (2, 4),
+        (3, 5),
+        (1, 4),
+        (3, 6),
+        (1, 2),
+        (3, 4),
+        (5, 6),
+    );
 }
 
 /// The best split of the samples, ordered by luminance, into a dark and a bright group.

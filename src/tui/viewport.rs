@@ -197,9 +197,12 @@ impl Viewport {
         self.cells.clear();
         self.cells
             .resize(usize::from(cols) * usize::from(rows), CellGlyph::default());
+        // One sample buffer filled in place: returning it by value per cell cost a
+        // stalled wide copy of bytes just written one at a time.
+        let mut s = [Sample::default(); 8];
         for cy in 0..rows {
             for cx in 0..cols {
-                let (s, n) = self.samples(cx, cy);
+                let n = self.samples_into(cx, cy, &mut s);
                 self.cells[usize::from(cy) * usize::from(cols) + usize::from(cx)] = fit_cell(
                     self.settings.glyphs,
                     &s[..n],
@@ -213,23 +216,32 @@ impl Viewport {
     /// The samples of cell `(cx, cy)`, row-major, and how many there are.
     #[must_use]
     pub fn samples(&self, cx: u16, cy: u16) -> ([Sample; 8], usize) {
-        let (sx, sy) = self.settings.glyphs.dims();
         let mut out = [Sample::default(); 8];
+        let n = self.samples_into(cx, cy, &mut out);
+        (out, n)
+    }
+
+    /// [`Viewport::samples`] into `out`.
+    #[inline]
+    fn samples_into(&self, cx: u16, cy: u16, out: &mut [Sample; 8]) -> usize {
+        let (sx, sy) = self.settings.glyphs.dims();
         let w = self.target.width as usize;
         for j in 0..sy {
             for i in 0..sx {
                 let x = usize::from(cx) * sx as usize + i as usize;
                 let y = usize::from(cy) * sy as usize + j as usize;
-                if let Some(p) = self.color.0.get(y * w + x) {
-                    // Alpha is coverage: 255 or 0, or a fraction after supersampling.
-                    out[(j * sx + i) as usize] = Sample {
-                        rgb: [p[0], p[1], p[2]],
-                        covered: p[3] >= 128,
-                    };
-                }
+                // Alpha is coverage: 255 or 0, or a fraction after supersampling.
+                out[(j * sx + i) as usize] =
+                    self.color
+                        .0
+                        .get(y * w + x)
+                        .map_or(Sample::default(), |p| Sample {
+                            rgb: [p[0], p[1], p[2]],
+                            covered: p[3] >= 128,
+                        });
             }
         }
-        (out, (sx * sy) as usize)
+        (sx * sy) as usize
     }
 
     /// The glyph of a cell.

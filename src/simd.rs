@@ -63,6 +63,10 @@ pub trait F32s:
     fn le(self, o: Self) -> Self;
     /// `a` where `mask` is set, else `b`.
     fn select(mask: Self, a: Self, b: Self) -> Self;
+    /// `self > o ? self : o` per lane (x86's `maxps`: `o` when either is NaN).
+    fn max(self, o: Self) -> Self;
+    /// `self < o ? self : o` per lane (x86's `minps`: `o` when either is NaN).
+    fn min(self, o: Self) -> Self;
     /// The sign bit of lane `i` in bit `i` (for masks: which lanes are set).
     fn bitmask(self) -> u8;
     /// Truncation towards zero, for values within `i32` range.
@@ -130,6 +134,15 @@ impl F32s for f32x8 {
     #[inline(always)]
     fn select(mask: Self, a: Self, b: Self) -> Self {
         mask.select(a, b)
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        // Spelled as its definition: `wide`'s own max may treat NaN differently.
+        F32s::select(F32s::gt(self, o), self, o)
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        F32s::select(F32s::lt(self, o), self, o)
     }
     #[inline(always)]
     fn bitmask(self) -> u8 {
@@ -261,6 +274,14 @@ pub(crate) mod avx2 {
             F32x8(unsafe { _mm256_blendv_ps(b.0, a.0, mask.0) })
         }
         #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            F32x8(unsafe { _mm256_max_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            F32x8(unsafe { _mm256_min_ps(self.0, o.0) })
+        }
+        #[inline(always)]
         fn bitmask(self) -> u8 {
             unsafe { _mm256_movemask_ps(self.0) as u8 }
         }
@@ -336,6 +357,8 @@ mod tests {
         push(x.lt(y));
         push(x.le(y));
         push(F::select(x.lt(y), x, y));
+        push(x.max(y));
+        push(x.min(y));
         push(F::I::from_bits(m).cast_f32());
         let i = F::I::from_array(k);
         push(i.to_f32());

@@ -78,8 +78,7 @@ impl Shader for Lambert<'_> {
         let d = x * F::splat(lt.x) + y * F::splat(lt.y) + z * F::splat(lt.z);
         let l = d / len;
         // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
-        let zero = F::splat(0.0);
-        let l = F::select(l.gt(zero), l, zero);
+        let l = l.max(F::splat(0.0));
         let a = F::splat(self.ambient);
         let k = a + (F::splat(1.0) - a) * l;
         each3!(|i| F::splat(self.base[i]) * k)

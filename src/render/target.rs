@@ -43,9 +43,8 @@ pub fn to_u8(v: f32) -> u8 {
 #[must_use]
 #[inline(always)]
 pub fn to_u8x8<F: F32s>(v: F) -> F::I {
-    let (zero, one) = (F::splat(0.0), F::splat(1.0));
-    let v = F::select(v.gt(zero), v, zero);
-    let v = F::select(v.lt(one), v, one);
+    // max(NaN, 0) is 0, as NaN's `as u8` is in `to_u8`.
+    let v = v.max(F::splat(0.0)).min(F::splat(1.0));
     (v * F::splat(255.0) + F::splat(0.5)).trunc_i32()
 }
 

@@ -393,7 +393,11 @@ mod tests {
             m in any::<u8>(),
             k in prop::array::uniform8(any::<i32>()),
         ) {
-            prop_assume!(std::arch::is_x86_feature_detected!("avx2"));
+            // Without AVX2 there is no second backend to compare (and `prop_assume!`
+            // would reject every case and fail the run).
+            if !std::arch::is_x86_feature_detected!("avx2") {
+                return Ok(());
+            }
             let base = ops::<f32x8>(a, b, m, k);
             // SAFETY of the AVX2 lanes: the CPU was checked just above.
             let fast = ops::<avx2::F32x8>(a, b, m, k);

@@ -4,7 +4,7 @@
 //!
 //! - on [`wide`]'s `f32x8`/`i32x8`, for the build's target (on baseline x86-64 each
 //!   is two SSE halves);
-//! - on AVX2 registers ([`avx2`]), instantiated only inside
+//! - on AVX2 registers (the crate-private `avx2` module), instantiated only inside
 //!   [`crate::render::Renderer`]'s AVX2 draw loop, which runs after the CPU was checked.
 //!
 //! `wide` picks its implementation when the crate is compiled, so a function compiled

@@ -109,7 +109,7 @@ pub fn wide<S: CoverageSink>(s: &Setup, sink: &mut S) {
     wide_lanes::<i32x8, S>(s, sink);
 }
 
-/// [`wide`] on the `i32` lanes of backend `L` (see [`crate::simd`]): identical
+/// [`wide()`] on the `i32` lanes of backend `L` (see [`crate::simd`]): identical
 /// coverage and edge values, different instructions.
 #[inline(always)]
 pub fn wide_lanes<L: I32s, S: CoverageSink>(s: &Setup, sink: &mut S) {

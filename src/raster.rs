@@ -45,15 +45,6 @@ pub mod setup;
 pub mod sink;
 pub mod traverse;
 
-/// `[a, b, c].map(f)`, always inlined. `array::map` goes through `try_map`, which the
-/// compiler leaves out of line for SIMD closures in the per-group paths, spilling
-/// every lane to memory.
-#[inline(always)]
-pub fn map3<T, U>(v: [T; 3], mut f: impl FnMut(T) -> U) -> [U; 3] {
-    let [a, b, c] = v;
-    [f(a), f(b), f(c)]
-}
-
 pub use setup::{
     EDGE_NAMES, GUARD_BAND_PX, PixelRect, Reject, SUBPIXEL_BITS, SUBPIXEL_ONE, Setup, Target, snap,
 };

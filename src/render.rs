@@ -24,7 +24,7 @@ use crate::raster::depth::{DepthBuffer, DepthFunc, DepthState};
 use crate::raster::interp::{
     Interpolation, Varying, perspective_weights, span_lerp, span_position,
 };
-use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup, Target, Traversal, map3};
+use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup, Target, Traversal};
 use crate::simd::{F32s, I32s, each3};
 pub use target::{ColorTarget, Luma, Rgba8};
 
@@ -216,7 +216,7 @@ impl<V: Varying> Prepared<V> {
     #[inline(always)]
     fn bary_of(&self, f: [i64; 3]) -> [f32; 3] {
         let s = &self.setup;
-        let fl = map3([0, 1, 2], |e| {
+        let fl = each3!(|e| {
             let g = (f[e] + s.bias[e]) >> SUBPIXEL_BITS;
             edge_value(g as f32, self.edge_rem[e])
         });

@@ -19,11 +19,14 @@ use std::marker::PhantomData;
 use glam::{Vec3, Vec4};
 
 use crate::counters::{self, Stage};
-use crate::raster::clip::{ClipOutcome, ClipVertex, classify, clip_straddling, guard_band_ndc};
+use crate::raster::clip::{
+    ClipOutcome, ClipVertex, classify_codes, clip_straddling, guard_band_ndc, outcode,
+};
 use crate::raster::depth::{DepthBuffer, DepthFunc, DepthState};
 use crate::raster::interp::{
     Interpolation, Varying, perspective_weights, span_lerp, span_position,
 };
+use crate::raster::setup::snap;
 use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup, Target, Traversal};
 use crate::simd::{F32s, I32s, each3};
 pub use target::{ColorTarget, Luma, Rgba8};
@@ -39,18 +42,18 @@ pub trait Shader {
     fn fragment(&self, v: &Self::Varying) -> Vec3;
 
     /// Colours of up to 8 fragments of one triangle at once, as red, green and blue
-    /// lanes: lane `k` (for each set bit of `mask`) has weights `w[..][k]` for the vertex
-    /// varyings `var`. The default interpolates and shades lane by lane; shaders
-    /// override it with 8-lane code that must give the same bits as
-    /// [`Shader::fragment`] (the probe relies on it).
+    /// lanes: lane `k` (for each set bit of `mask`) has weights `w[..][k]` for the
+    /// triangle's varyings in relative form `rel` (see [`Varying::relative`]). The
+    /// default interpolates and shades lane by lane; shaders override it with 8-lane
+    /// code that must give the same bits as [`Shader::fragment`] (the probe relies on it).
     #[inline(always)]
-    fn fragment8<F: F32s>(&self, var: &[Self::Varying; 3], w: &[F; 3], mask: u8) -> [F; 3] {
+    fn fragment8<F: F32s>(&self, rel: &[Self::Varying; 3], w: &[F; 3], mask: u8) -> [F; 3] {
         let w = each3!(|i| w[i].to_array());
         let mut out = [[0f32; 8]; 3];
         let mut m = mask;
         while m != 0 {
             let k = m.trailing_zeros() as usize;
-            let v = Self::Varying::weighted(&var[0], &var[1], &var[2], [w[0][k], w[1][k], w[2][k]]);
+            let v = Self::Varying::from_relative(rel, [w[0][k], w[1][k], w[2][k]]);
             let c = self.fragment(&v);
             (out[0][k], out[1][k], out[2][k]) = (c.x, c.y, c.z);
             m &= m - 1;
@@ -140,6 +143,8 @@ pub struct Prepared<V> {
     /// 1/w of each vertex.
     pub inv_w: [f32; 3],
     pub var: [V; 3],
+    /// The varyings in relative form (see [`Varying::relative`]).
+    pub rel: [V; 3],
     /// `1 / area2`, rounded once to f32: barycentrics are `F · inv_area2`.
     pub inv_area2: f32,
     /// `F0e − 256·G0e` per edge (see [`Setup::reduced_edge`]): the same at every pixel,
@@ -249,8 +254,7 @@ impl<V: Varying> Prepared<V> {
     #[inline(always)]
     #[must_use]
     pub fn varyings(&self, e: &PixelEval, mode: Interpolation) -> V {
-        let w = self.weights(e, mode);
-        V::weighted(&self.var[0], &self.var[1], &self.var[2], w)
+        V::from_relative(&self.rel, self.weights(e, mode))
     }
 }
 
@@ -297,11 +301,77 @@ impl<V, F: FnMut(&Prepared<V>)> EmitPiece<V> for F {
     }
 }
 
+/// A vertex's clip outcode and projection, computed once per vertex per draw (most
+/// vertices are shared by about six triangles) and identically for clipped vertices,
+/// so a triangle set up from these is bit for bit the triangle set up from scratch.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Projected {
+    /// See [`outcode`].
+    out: u8,
+    /// Whether both screen coordinates snapped (finite and within the guard band).
+    snapped: bool,
+    inv_w: f32,
+    /// Screen position in pixels, before snapping.
+    screen: [f32; 2],
+    /// NDC depth.
+    z: f32,
+    /// Snapped screen position in subpixels.
+    fixed: [i64; 2],
+}
+
+impl Projected {
+    /// Classifies and projects a clip-space position for a target.
+    #[inline(always)]
+    #[must_use]
+    pub fn of(pos: Vec4, target: Target, guard: [f32; 2]) -> Self {
+        let (fw, fh) = (target.width as f32, target.height as f32);
+        let inv_w = 1.0 / pos.w;
+        let p = pos * inv_w;
+        let screen = [(p.x * 0.5 + 0.5) * fw, (0.5 - p.y * 0.5) * fh];
+        let (sx, sy) = (snap(f64::from(screen[0])), snap(f64::from(screen[1])));
+        Self {
+            out: outcode(pos, guard),
+            snapped: sx.is_some() && sy.is_some(),
+            inv_w,
+            screen,
+            z: pos.z * inv_w,
+            fixed: [sx.unwrap_or(0), sy.unwrap_or(0)],
+        }
+    }
+}
+
+/// Projects every vertex of `cache` for `target` into `out` (reusing its storage).
+pub fn project_vertices<V>(cache: &VertexCache<V>, target: Target, out: &mut Vec<Projected>) {
+    let guard = guard_band_ndc(target.width, target.height);
+    out.clear();
+    out.extend(
+        cache
+            .verts
+            .iter()
+            .map(|v| Projected::of(v.pos, target, guard)),
+    );
+}
+
 /// Clips, projects and sets up mesh triangle `t`, calling `emit` for each piece that
 /// reaches the rasterizer. Shared by the renderer and the probe.
 #[inline(always)]
 pub fn prepare<V: Varying>(
     cache: &VertexCache<V>,
+    indices: &[u32],
+    t: u32,
+    target: Target,
+    cull: Cull,
+    emit: &mut impl EmitPiece<V>,
+) -> PrepareOutcome {
+    prepare_projected(cache, None, indices, t, target, cull, emit)
+}
+
+/// [`prepare`] with the vertices' projections from [`project_vertices`] (for this
+/// cache and target) when given, else computed here: the result is the same.
+#[inline(always)]
+pub fn prepare_projected<V: Varying>(
+    cache: &VertexCache<V>,
+    projected: Option<&[Projected]>,
     indices: &[u32],
     t: u32,
     target: Target,
@@ -316,20 +386,39 @@ pub fn prepare<V: Varying>(
     let (Some(a), Some(b), Some(c)) = (fetch(tri[0]), fetch(tri[1]), fetch(tri[2])) else {
         return PrepareOutcome::Rejected;
     };
-    let tri = [a, b, c];
     let guard = guard_band_ndc(target.width, target.height);
-    let outcome = classify(&tri, guard);
+    let proj = match projected {
+        Some(p) => match (
+            p.get(tri[0] as usize),
+            p.get(tri[1] as usize),
+            p.get(tri[2] as usize),
+        ) {
+            (Some(&pa), Some(&pb), Some(&pc)) => [pa, pb, pc],
+            _ => return PrepareOutcome::Rejected,
+        },
+        None => {
+            let v = [a, b, c];
+            each3!(|i| Projected::of(v[i].pos, target, guard))
+        }
+    };
+    let tri = [a, b, c];
+    let outcome = classify_codes(each3!(|i| proj[i].out));
     let clipped = outcome == ClipOutcome::Clipped;
     let mut seen = Seen::default();
     match outcome {
         ClipOutcome::Rejected => return PrepareOutcome::Rejected,
-        ClipOutcome::Inside => emit_piece(t, 0, clipped, tri, target, cull, emit, &mut seen),
+        ClipOutcome::Inside => {
+            let var = each3!(|i| tri[i].var);
+            seen.add(setup_piece(t, 0, clipped, proj, var, target, cull), emit);
+        }
         ClipOutcome::Clipped => {
             let Some(poly) = clip_straddling(tri, guard) else {
                 return PrepareOutcome::Rejected;
             };
             for (i, tri) in poly.triangles().enumerate() {
-                emit_piece(t, i, clipped, tri, target, cull, emit, &mut seen);
+                let proj = each3!(|i| Projected::of(tri[i].pos, target, guard));
+                let var = each3!(|i| tri[i].var);
+                seen.add(setup_piece(t, i, clipped, proj, var, target, cull), emit);
             }
         }
     }
@@ -347,27 +436,19 @@ struct Seen {
     culled: bool,
 }
 
-/// Sets up one piece and hands it on. A function rather than a closure so that it
-/// inlines (see [`EmitPiece`]).
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn emit_piece<V: Varying>(
-    t: u32,
-    piece: usize,
-    clipped: bool,
-    tri: [ClipVertex<V>; 3],
-    target: Target,
-    cull: Cull,
-    emit: &mut impl EmitPiece<V>,
-    seen: &mut Seen,
-) {
-    match setup_piece(t, piece, clipped, tri, target, cull) {
-        Piece::Drawn(p) => {
-            emit.piece(&p);
-            seen.drawn = true;
+impl Seen {
+    /// Hands a set-up piece on and notes what became of it. A method rather than a
+    /// closure so that it inlines (see [`EmitPiece`]).
+    #[inline(always)]
+    fn add<V>(&mut self, piece: Piece<V>, emit: &mut impl EmitPiece<V>) {
+        match piece {
+            Piece::Drawn(p) => {
+                emit.piece(&p);
+                self.drawn = true;
+            }
+            Piece::Culled => self.culled = true,
+            Piece::Rejected => {}
         }
-        Piece::Culled => seen.culled = true,
-        Piece::Rejected => {}
     }
 }
 
@@ -380,25 +461,22 @@ enum Piece<V> {
     Rejected,
 }
 
-/// Projects and sets up one (possibly clipped) triangle whose vertices all have w > 0.
+/// Sets up one (possibly clipped) triangle whose vertices all have w > 0, from their
+/// projections.
 #[inline(always)]
 fn setup_piece<V: Varying>(
     t: u32,
     piece: usize,
     clipped: bool,
-    tri: [ClipVertex<V>; 3],
+    proj: [Projected; 3],
+    var: [V; 3],
     target: Target,
     cull: Cull,
 ) -> Piece<V> {
-    let (fw, fh) = (target.width as f32, target.height as f32);
-    let inv_w = tri.map(|v| 1.0 / v.pos.w);
-    let screen = [0, 1, 2].map(|i| {
-        let p = tri[i].pos * inv_w[i];
-        [(p.x * 0.5 + 0.5) * fw, (0.5 - p.y * 0.5) * fh]
-    });
-    let z = [0, 1, 2].map(|i| tri[i].pos.z * inv_w[i]);
-    let xy = screen.map(|p| [f64::from(p[0]), f64::from(p[1])]);
-    let Ok(setup) = Setup::new(xy, target) else {
+    if !proj.iter().all(|p| p.snapped) {
+        return Piece::Rejected;
+    }
+    let Ok(setup) = Setup::from_fixed(each3!(|i| proj[i].fixed), target) else {
         return Piece::Rejected;
     };
     // Counter-clockwise in NDC (y-up) is negative area in y-down screen space.
@@ -407,7 +485,7 @@ fn setup_piece<V: Varying>(
     }
     let order = |i: usize| if setup.flipped && i > 0 { 3 - i } else { i };
     let (ox, oy) = (i64::from(setup.bbox.x0), i64::from(setup.bbox.y0));
-    let edge_rem = [0, 1, 2].map(|e| {
+    let edge_rem = each3!(|e| {
         let g = setup.reduced_edge(e, ox, oy);
         (setup.edge_raw(e, ox, oy) - (g << SUBPIXEL_BITS)) as f32
     });
@@ -416,10 +494,14 @@ fn setup_piece<V: Varying>(
         piece: piece as u8,
         clipped,
         setup,
-        screen: [0, 1, 2].map(|i| screen[order(i)]),
-        z: [0, 1, 2].map(|i| z[order(i)]),
-        inv_w: [0, 1, 2].map(|i| inv_w[order(i)]),
-        var: [0, 1, 2].map(|i| tri[order(i)].var),
+        screen: each3!(|i| proj[order(i)].screen),
+        z: each3!(|i| proj[order(i)].z),
+        inv_w: each3!(|i| proj[order(i)].inv_w),
+        var: each3!(|i| var[order(i)]),
+        rel: {
+            let v = each3!(|i| var[order(i)]);
+            V::relative(&v[0], &v[1], &v[2])
+        },
         inv_area2: (1.0 / setup.area2 as f64) as f32,
         edge_rem,
     })
@@ -546,7 +628,7 @@ impl<S: Shader, C: ColorTarget, L: I32s> Fragments<'_, S, C, L> {
             Interpolation::Affine => b,
             mode => span_weights8(t, mode.span().unwrap_or(8), x0, y),
         };
-        let colors = self.shader.fragment8(&t.var, &w, pass);
+        let colors = self.shader.fragment8(&t.rel, &w, pass);
         self.color.put8(start, pass, &colors);
         self.shaded += u64::from(pass.count_ones());
     }
@@ -609,7 +691,9 @@ impl<S: Shader, C: ColorTarget, L: I32s> EmitPiece<S::Varying> for Raster<'_, S,
 pub enum Isa {
     /// The build's target (baseline x86-64: 8-lane types run as two SSE halves).
     Baseline,
-    /// x86-64 with AVX2, chosen at run time when the CPU has it.
+    /// x86-64 with AVX2 (and the POPCNT and BMI1 that every AVX2 CPU has, for the
+    /// per-group fragment counts and lane loops), chosen at run time when the CPU has
+    /// them.
     Avx2,
 }
 
@@ -617,11 +701,23 @@ impl Isa {
     /// The best the running CPU supports.
     #[must_use]
     pub fn detect() -> Self {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
+        if Self::has_avx2() {
             return Isa::Avx2;
         }
         Isa::Baseline
+    }
+
+    /// Whether the CPU has what [`Isa::Avx2`] is compiled for.
+    #[must_use]
+    pub fn has_avx2() -> bool {
+        #[cfg(target_arch = "x86_64")]
+        {
+            std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("popcnt")
+                && std::arch::is_x86_feature_detected!("bmi1")
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        false
     }
 }
 
@@ -633,6 +729,8 @@ pub struct Renderer {
     pub stats: DrawStats,
     /// The draw loop's instruction set; [`Isa::detect`] by default.
     pub isa: Isa,
+    /// The current draw's vertex projections, reused between draws.
+    projected: Vec<Projected>,
 }
 
 impl Renderer {
@@ -644,6 +742,7 @@ impl Renderer {
             depth: DepthBuffer::new(target.width, target.height),
             stats: DrawStats::default(),
             isa: Isa::detect(),
+            projected: Vec::new(),
         }
     }
 
@@ -697,8 +796,8 @@ impl Renderer {
             self.depth.reset(self.target.width, self.target.height);
         }
         #[cfg(target_arch = "x86_64")]
-        if self.isa == Isa::Avx2 && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2, checked just above.
+        if self.isa == Isa::Avx2 && Isa::has_avx2() {
+            // SAFETY: the CPU has AVX2, POPCNT and BMI1, checked just above.
             unsafe { self.draw_avx2(shader, cache, indices, opts, color) };
             return;
         }
@@ -710,7 +809,7 @@ impl Renderer {
     /// the instruction selection differs: no operation is fused or reordered, so the
     /// output is bit-identical to the baseline path (the tests compare both).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,popcnt,bmi1")]
     unsafe fn draw_avx2<S: Shader, C: ColorTarget>(
         &mut self,
         shader: &S,
@@ -732,6 +831,8 @@ impl Renderer {
         color: &mut C,
     ) {
         let target = self.target;
+        let mut projected = std::mem::take(&mut self.projected);
+        project_vertices(cache, target, &mut projected);
         let mut raster = Raster {
             shader,
             depth: &mut self.depth,
@@ -744,7 +845,8 @@ impl Renderer {
         let n = (indices.len() / 3) as u32;
         for t in 0..n {
             raster.stats.triangles += 1;
-            match prepare(cache, indices, t, target, opts.cull, &mut raster) {
+            let proj = Some(projected.as_slice());
+            match prepare_projected(cache, proj, indices, t, target, opts.cull, &mut raster) {
                 PrepareOutcome::Rejected => raster.stats.rejected += 1,
                 PrepareOutcome::Culled => raster.stats.culled += 1,
                 PrepareOutcome::Drawn { clipped } => {
@@ -755,5 +857,6 @@ impl Renderer {
         }
         let stats = raster.stats;
         self.stats += stats;
+        self.projected = projected;
     }
 }

@@ -74,32 +74,60 @@ fn distances(p: Vec4, guard: [f32; 2]) -> [f32; 6] {
     ]
 }
 
+/// Outcode bits 0–5: the vertex lies outside clip plane 0–5 (near, far, then the
+/// guard band's −x… order of [`distances`]).
+pub const OUT_PLANES: u8 = 0x3f;
+/// Outcode bit: `w ≤ 0` (or NaN).
+pub const OUT_W_NOT_POSITIVE: u8 = 0x40;
+/// Outcode bit: a coordinate is NaN or infinite (no other bit is then set).
+pub const OUT_NOT_FINITE: u8 = 0x80;
+
+/// A vertex's outcode: which planes it lies outside of, whether `w ≤ 0`, whether it
+/// is non-finite. Computed once per vertex; [`classify_codes`] combines three.
+#[must_use]
+#[inline(always)]
+pub fn outcode(p: Vec4, guard: [f32; 2]) -> u8 {
+    if !p.is_finite() {
+        return OUT_NOT_FINITE;
+    }
+    let d = distances(p, guard);
+    let mut code = 0;
+    for (plane, d) in d.iter().enumerate() {
+        code |= u8::from(*d < 0.0) << plane;
+    }
+    // `!(w > 0)` rather than `w <= 0`: the same for the finite values that get here.
+    code | if p.w > 0.0 { 0 } else { OUT_W_NOT_POSITIVE }
+}
+
+/// Where a triangle with these vertex outcodes lies: `Inside` (draw as is),
+/// `Rejected` (nothing left: non-finite, or all three outside one plane, or
+/// inside every plane yet with a `w ≤ 0`, which only `w = 0` on every vertex allows)
+/// or `Clipped` (call [`clip_straddling`]).
+#[must_use]
+#[inline(always)]
+pub fn classify_codes(codes: [u8; 3]) -> ClipOutcome {
+    let any = codes[0] | codes[1] | codes[2];
+    let all = codes[0] & codes[1] & codes[2];
+    if any & OUT_NOT_FINITE != 0 || all & OUT_PLANES != 0 {
+        ClipOutcome::Rejected
+    } else if any & OUT_PLANES != 0 {
+        ClipOutcome::Clipped
+    } else if any & OUT_W_NOT_POSITIVE != 0 {
+        // w must be positive after the near plane; z ≥ 0 and z ≤ w force w ≥ 0, so
+        // this is w = 0 exactly.
+        ClipOutcome::Rejected
+    } else {
+        ClipOutcome::Inside
+    }
+}
+
 /// Where a triangle lies against the clip planes, without clipping it: `Inside` (draw
 /// as is), `Rejected` (nothing left) or `Clipped` (call [`clip_triangle`]). Most
 /// triangles of a frame are inside, and this keeps them from building a polygon.
 #[must_use]
 #[inline]
 pub fn classify<V>(tri: &[ClipVertex<V>; 3], guard: [f32; 2]) -> ClipOutcome {
-    if tri.iter().any(|v| !v.pos.is_finite()) {
-        return ClipOutcome::Rejected;
-    }
-    let d = tri.each_ref().map(|v| distances(v.pos, guard));
-    let mut outcome = ClipOutcome::Inside;
-    for plane in 0..6 {
-        let outside = d.iter().filter(|d| d[plane] < 0.0).count();
-        if outside == 3 {
-            return ClipOutcome::Rejected;
-        }
-        if outside > 0 {
-            outcome = ClipOutcome::Clipped;
-        }
-    }
-    // w must be positive after the near plane; w = 0 exactly on every vertex is
-    // caught here too (z ≥ 0 and z ≤ w force w ≥ 0).
-    if outcome == ClipOutcome::Inside && !tri.iter().all(|v| v.pos.w > 0.0) {
-        return ClipOutcome::Rejected;
-    }
-    outcome
+    classify_codes(tri.each_ref().map(|v| outcode(v.pos, guard)))
 }
 
 /// Clips a triangle. `guard` is the guard band in NDC units for x and y

@@ -17,7 +17,17 @@ pub trait Varying: Copy {
     /// as `a + (b − a)·w[1] + (c − a)·w[2]`: a constant attribute stays exactly
     /// constant and a pixel at vertex A gets exactly A's value, which the sum
     /// `a·w[0] + b·w[1] + c·w[2]` does not guarantee in floating point.
-    fn weighted(a: &Self, b: &Self, c: &Self, w: [f32; 3]) -> Self;
+    fn weighted(a: &Self, b: &Self, c: &Self, w: [f32; 3]) -> Self {
+        Self::from_relative(&Self::relative(a, b, c), w)
+    }
+
+    /// `[a, b − a, c − a]`, what [`Varying::from_relative`] interpolates: computed once
+    /// per triangle instead of once per pixel.
+    fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3];
+
+    /// `r[0] + r[1]·w[1] + r[2]·w[2]` for `r` from [`Varying::relative`]: exactly
+    /// [`Varying::weighted`] of the vertices `r` came from.
+    fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self;
 
     /// `a + (b − a)·t`, used by clipping (linear in clip space).
     fn lerp(a: &Self, b: &Self, t: f32) -> Self;
@@ -27,8 +37,12 @@ macro_rules! vector_varying {
     ($($t:ty),*) => {$(
         impl Varying for $t {
             #[inline(always)]
-            fn weighted(a: &Self, b: &Self, c: &Self, w: [f32; 3]) -> Self {
-                *a + (*b - *a) * w[1] + (*c - *a) * w[2]
+            fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3] {
+                [*a, *b - *a, *c - *a]
+            }
+            #[inline(always)]
+            fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
+                r[0] + r[1] * w[1] + r[2] * w[2]
             }
             #[inline(always)]
             fn lerp(a: &Self, b: &Self, t: f32) -> Self {
@@ -41,17 +55,27 @@ vector_varying!(f32, Vec2, Vec3, Vec4);
 
 impl Varying for () {
     #[inline(always)]
-    fn weighted(_: &Self, _: &Self, _: &Self, _: [f32; 3]) -> Self {}
+    fn relative(_: &Self, _: &Self, _: &Self) -> [Self; 3] {
+        [(); 3]
+    }
+    #[inline(always)]
+    fn from_relative(_: &[Self; 3], _: [f32; 3]) -> Self {}
     #[inline(always)]
     fn lerp(_: &Self, _: &Self, _: f32) -> Self {}
 }
 
 impl<A: Varying, B: Varying> Varying for (A, B) {
     #[inline(always)]
-    fn weighted(a: &Self, b: &Self, c: &Self, w: [f32; 3]) -> Self {
+    fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3] {
+        let [a0, a1, a2] = A::relative(&a.0, &b.0, &c.0);
+        let [b0, b1, b2] = B::relative(&a.1, &b.1, &c.1);
+        [(a0, b0), (a1, b1), (a2, b2)]
+    }
+    #[inline(always)]
+    fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
         (
-            A::weighted(&a.0, &b.0, &c.0, w),
-            B::weighted(&a.1, &b.1, &c.1, w),
+            A::from_relative(&[r[0].0, r[1].0, r[2].0], w),
+            B::from_relative(&[r[0].1, r[1].1, r[2].1], w),
         )
     }
     #[inline(always)]

@@ -161,7 +161,8 @@ impl Setup {
     /// Sets up a triangle whose vertices are already on the subpixel grid.
     pub fn from_fixed(mut v: [[i64; 2]; 3], target: Target) -> Result<Self, Reject> {
         let limit = (GUARD_BAND_PX as i64) * SUBPIXEL_ONE;
-        if v.iter().flatten().any(|c| c.abs() > limit) {
+        let far = |p: [i64; 2]| p[0].abs() > limit || p[1].abs() > limit;
+        if far(v[0]) || far(v[1]) || far(v[2]) {
             return Err(Reject::BeyondGuardBand);
         }
         // The box first: at terminal resolutions many triangles hold no pixel centre.
@@ -296,8 +297,9 @@ fn pixel_bounds(v: &[[i64; 2]; 3], target: Target) -> Option<PixelRect> {
     if target.is_empty() {
         return None;
     }
-    let lo = |c: usize| v.iter().map(|p| p[c]).min().unwrap_or(0);
-    let hi = |c: usize| v.iter().map(|p| p[c]).max().unwrap_or(0);
+    // Written out: iterator chains here stay out of line in the renderer's loop.
+    let lo = |c: usize| v[0][c].min(v[1][c]).min(v[2][c]);
+    let hi = |c: usize| v[0][c].max(v[1][c]).max(v[2][c]);
     // Centre of pixel n is n*256 + 128: first centre ≥ lo, last centre ≤ hi.
     let first = |lo: i64| (lo - HALF_PIXEL + SUBPIXEL_ONE - 1).div_euclid(SUBPIXEL_ONE);
     let last = |hi: i64| (hi - HALF_PIXEL).div_euclid(SUBPIXEL_ONE);

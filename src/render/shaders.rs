@@ -66,13 +66,11 @@ impl Shader for Lambert<'_> {
     }
 
     #[inline(always)]
-    fn fragment8<F: F32s>(&self, var: &[Vec3; 3], w: &[F; 3], _mask: u8) -> [F; 3] {
-        // `Varying::weighted` lane by lane: a + (b − a)·w1 + (c − a)·w2.
-        let [p, q, r] = var;
-        let [x, y, z] = each3!(|i| {
-            let (a, b, c) = (p[i], q[i], r[i]);
-            F::splat(a) + F::splat(b - a) * w[1] + F::splat(c - a) * w[2]
-        });
+    fn fragment8<F: F32s>(&self, rel: &[Vec3; 3], w: &[F; 3], _mask: u8) -> [F; 3] {
+        // `Varying::from_relative` lane by lane: a + (b − a)·w1 + (c − a)·w2.
+        let [a, ba, ca] = rel;
+        let [x, y, z] =
+            each3!(|i| F::splat(a[i]) + F::splat(ba[i]) * w[1] + F::splat(ca[i]) * w[2]);
         let len = (x * x + y * y + z * z).sqrt();
         let lt = self.light;
         let d = x * F::splat(lt.x) + y * F::splat(lt.y) + z * F::splat(lt.z);
@@ -80,7 +78,7 @@ impl Shader for Lambert<'_> {
         // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
         let l = l.max(F::splat(0.0));
         let a = F::splat(self.ambient);
-        let k = a + (F::splat(1.0) - a) * l;
+        let k = a + F::splat(1.0 - self.ambient) * l;
         each3!(|i| F::splat(self.base[i]) * k)
     }
 }

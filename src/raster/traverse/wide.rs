@@ -80,7 +80,7 @@ impl Lanes for Lanes64 {
 #[inline(always)]
 fn reduced(s: &Setup) -> ([i64; 3], [i64; 3], [i64; 3]) {
     let (x, y) = (s.bbox.x0.into(), s.bbox.y0.into());
-    ([0, 1, 2].map(|e| s.reduced_edge(e, x, y)), s.i, s.j)
+    (each3!(|e| s.reduced_edge(e, x, y)), s.i, s.j)
 }
 
 /// Whether every value the `wide` traversal forms for this setup fits in `i32`: the
@@ -89,14 +89,17 @@ fn reduced(s: &Setup) -> ([i64; 3], [i64; 3], [i64; 3]) {
 /// inequality from the box origin (`|G0| + |I|·(w + 14) + |J|·h`): a few operations,
 /// conservative, and cheap because tiny triangles pay it as often as they cover pixels.
 #[must_use]
+#[inline(always)]
 pub fn fits_i32(s: &Setup) -> bool {
     let b = s.bbox;
     let (g, i, j) = reduced(s);
     let (w, h) = (u64::from(b.width()) + 14, u64::from(b.height()));
-    (0..3).all(|e| {
+    let fits = |e: usize| {
         let (ax, ay) = (i[e].unsigned_abs(), j[e].unsigned_abs());
         g[e].unsigned_abs() + 8 * ax + ax * w + ay * h <= i32::MAX as u64
-    })
+    };
+    // Not `(0..3).all(..)`: the iterator stays out of line in the renderer's loop.
+    fits(0) && fits(1) && fits(2)
 }
 
 /// Pixel-parallel traversal: 8 pixels per step, the fast path, on the reduced edge
@@ -145,46 +148,80 @@ fn row_range(f: [i64; 3], sx: [i64; 3], x0: u32, x1: u32) -> Option<(u32, u32)> 
 #[inline(always)]
 fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
     let b = s.bbox;
+    // Boxes of two groups or fewer gain nothing from the per-row range.
+    if b.width() <= 16 {
+        walk_narrow::<L, S>(s, sink);
+        return;
+    }
     let (mut row, sx, sy) = reduced(s);
     let step8 = each3!(|e| L::splat(sx[e] * 8));
     // Lane offsets `i·sx`, built once per triangle; a row start is one splat and add.
     let ramp = each3!(|e| L::ramp(0, sx[e]));
-    // Boxes of two groups or fewer gain nothing from the per-row range.
-    let narrow = b.width() <= 16;
     for y in b.y0..=b.y1 {
-        let range = if narrow {
-            Some((b.x0, b.x1))
-        } else {
-            row_range(row, sx, b.x0, b.x1)
-        };
-        if let Some((lo, hi)) = range {
+        if let Some((lo, hi)) = row_range(row, sx, b.x0, b.x1) {
             // Groups are aligned to multiples of 8 in the target, so a sink can store
             // a group's mask as one byte. Lanes left of the box are masked off.
-            let mut x = lo & !7;
+            let x = lo & !7;
             let skip = i64::from(x) - i64::from(b.x0);
-            let mut f = each3!(|e| L::splat(row[e] + skip * sx[e]).add(ramp[e]));
-            let mut first = !0u8 << b.x0.saturating_sub(x).min(7);
-            loop {
-                let mut m = L::inside_mask(f[0], f[1], f[2]) & first;
-                first = !0;
-                let left = hi - x;
-                if left < 7 {
-                    m &= (1u8 << (left + 1)) - 1;
-                }
-                if m != 0 {
-                    L::emit(sink, y, x, m, &f);
-                }
-                if left < 8 {
-                    break;
-                }
-                x += 8;
-                for e in 0..3 {
-                    f[e] = f[e].add(step8[e]);
-                }
-            }
+            let f = each3!(|e| L::splat(row[e] + skip * sx[e]).add(ramp[e]));
+            let first = !0u8 << b.x0.saturating_sub(x).min(7);
+            walk_row(sink, y, x, hi, first, f, &step8);
         }
         for e in 0..3 {
             row[e] += sy[e];
+        }
+    }
+}
+
+/// [`walk`] for boxes at most 16 pixels wide (most triangles of a dense mesh): every
+/// row covers the same groups, so the lanes of a row start are the previous row's
+/// plus `J`, and only the box's columns are masked.
+#[inline(always)]
+fn walk_narrow<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
+    let b = s.bbox;
+    let (row, sx, sy) = reduced(s);
+    let step8 = each3!(|e| L::splat(sx[e] * 8));
+    let step_y = each3!(|e| L::splat(sy[e]));
+    let x = b.x0 & !7;
+    let skip = i64::from(x) - i64::from(b.x0);
+    let mut f = each3!(|e| L::ramp(row[e] + skip * sx[e], sx[e]));
+    let first = !0u8 << (b.x0 - x);
+    for y in b.y0..=b.y1 {
+        walk_row(sink, y, x, b.x1, first, f, &step8);
+        for e in 0..3 {
+            f[e] = f[e].add(step_y[e]);
+        }
+    }
+}
+
+/// The groups of one row from the aligned `x` to pixel `hi`: `f` holds the lanes of
+/// the first group, `first` masks the lanes of that group left of the range.
+#[inline(always)]
+fn walk_row<L: Lanes, S: CoverageSink>(
+    sink: &mut S,
+    y: u32,
+    mut x: u32,
+    hi: u32,
+    mut first: u8,
+    mut f: [L; 3],
+    step8: &[L; 3],
+) {
+    loop {
+        let mut m = L::inside_mask(f[0], f[1], f[2]) & first;
+        first = !0;
+        let left = hi - x;
+        if left < 7 {
+            m &= (1u8 << (left + 1)) - 1;
+        }
+        if m != 0 {
+            L::emit(sink, y, x, m, &f);
+        }
+        if left < 8 {
+            break;
+        }
+        x += 8;
+        for e in 0..3 {
+            f[e] = f[e].add(step8[e]);
         }
     }
 }

@@ -16,6 +16,7 @@ use termrast::accuracy::cases;
 use termrast::accuracy::depth::{DepthFormat, DepthPass};
 use termrast::accuracy::edge::EdgeArith;
 use termrast::camera::Camera;
+use termrast::raster::clip::{ClipOutcome, classify_codes, guard_band_ndc, outcode};
 use termrast::raster::depth::{DepthFunc, DepthState};
 use termrast::raster::interp::perspective_weights;
 use termrast::raster::line::{Line, NoTrace};
@@ -864,5 +865,67 @@ proptest! {
         for t in Traversal::ALL {
             let _ = coverage(t, tri, T);
         }
+    }
+}
+
+/// A clip-space coordinate: ordinary values, values on and near the planes, and the
+/// hostile ones (zero, subnormal-small, huge, infinite, NaN).
+fn clip_coord() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        4 => -3.0f32..3.0,
+        1 => Just(0.0f32),
+        1 => Just(-0.0f32),
+        1 => Just(1.0f32),
+        1 => Just(1e-30f32),
+        1 => Just(-1e-30f32),
+        1 => Just(1e30f32),
+        1 => Just(f32::INFINITY),
+        1 => Just(f32::NAN),
+    ]
+}
+
+/// The clip classification as first written: plane by plane over the distances, no
+/// outcodes. The renderer classifies from per-vertex outcodes instead.
+fn classify_reference(tri: &[Vec4; 3], guard: [f32; 2]) -> ClipOutcome {
+    if tri.iter().any(|p| !p.is_finite()) {
+        return ClipOutcome::Rejected;
+    }
+    let d = tri.map(|p| {
+        [
+            p.z,
+            p.w - p.z,
+            guard[0] * p.w - p.x,
+            guard[0] * p.w + p.x,
+            guard[1] * p.w - p.y,
+            guard[1] * p.w + p.y,
+        ]
+    });
+    let mut outcome = ClipOutcome::Inside;
+    for plane in 0..6 {
+        let outside = d.iter().filter(|d| d[plane] < 0.0).count();
+        if outside == 3 {
+            return ClipOutcome::Rejected;
+        }
+        if outside > 0 {
+            outcome = ClipOutcome::Clipped;
+        }
+    }
+    if outcome == ClipOutcome::Inside && !tri.iter().all(|p| p.w > 0.0) {
+        return ClipOutcome::Rejected;
+    }
+    outcome
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    /// Outcodes combine to exactly the plane-by-plane classification, hostile values
+    /// included.
+    #[test]
+    fn outcodes_classify_as_the_planes_do(c in prop::array::uniform12(clip_coord())) {
+        let tri = [0, 1, 2].map(|i| Vec4::new(c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]));
+        let guard = guard_band_ndc(64, 32);
+        let codes = tri.map(|p| outcode(p, guard));
+        prop_assert_eq!(classify_codes(codes), classify_reference(&tri, guard), "{:?}", tri);
     }
 }

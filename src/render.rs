@@ -508,7 +508,11 @@ fn setup_piece<V: Varying>(
 }
 
 /// The fragment loop of one triangle: receives coverage from the traversal.
-struct Fragments<'a, S: Shader, C, L> {
+///
+/// `STD` marks the default state (depth test `Less` with writes, perspective-correct
+/// interpolation) compiled as constants, so the per-group code carries no checks
+/// of the options; every other state runs with `STD = false` and reads `opts`.
+struct Fragments<'a, S: Shader, C, L, const STD: bool> {
     tri: &'a Prepared<S::Varying>,
     shader: &'a S,
     depth: &'a mut DepthBuffer,
@@ -521,23 +525,26 @@ struct Fragments<'a, S: Shader, C, L> {
     lanes: PhantomData<L>,
 }
 
-impl<S: Shader, C: ColorTarget, L: I32s> CoverageSink for Fragments<'_, S, C, L> {
+impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> CoverageSink
+    for Fragments<'_, S, C, L, STD>
+{
     #[inline(always)]
     fn pixel(&mut self, x: u32, y: u32) {
         let e = self.tri.eval(x, y);
         let i = y as usize * self.width + x as usize;
         self.fragments += 1;
-        if self.opts.depth.uses_buffer() {
+        let (depth_state, interpolation) = self.state();
+        if depth_state.uses_buffer() {
             counters::add(Stage::DepthTests, 1);
             let old = self.depth.data[i];
-            if !self.opts.depth.func.passes(e.depth, old) {
+            if !depth_state.func.passes(e.depth, old) {
                 return;
             }
-            if self.opts.depth.write {
+            if depth_state.write {
                 self.depth.data[i] = e.depth;
             }
         }
-        let v = self.tri.varyings(&e, self.opts.interpolation);
+        let v = self.tri.varyings(&e, interpolation);
         self.color.put(i, self.shader.fragment(&v));
         self.shaded += 1;
     }
@@ -571,7 +578,17 @@ impl<S: Shader, C: ColorTarget, L: I32s> CoverageSink for Fragments<'_, S, C, L>
     }
 }
 
-impl<S: Shader, C: ColorTarget, L: I32s> Fragments<'_, S, C, L> {
+impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L, STD> {
+    /// The draw's depth state and interpolation: constants when `STD`.
+    #[inline(always)]
+    fn state(&self) -> (DepthState, Interpolation) {
+        if STD {
+            (DepthState::default(), Interpolation::Perspective)
+        } else {
+            (self.opts.depth, self.opts.interpolation)
+        }
+    }
+
     /// The last group of a row whose width is not a multiple of 8, pixel by pixel.
     #[inline(never)]
     fn pixels(&mut self, y: u32, x0: u32, mask: u8) {
@@ -595,19 +612,20 @@ impl<S: Shader, C: ColorTarget, L: I32s> Fragments<'_, S, C, L> {
         let z = each3!(|e| F::splat(t.z[e]));
         let depth = b[0] * z[0] + b[1] * z[1] + b[2] * z[2];
         self.fragments += u64::from(mask.count_ones());
-        let pass = if self.opts.depth.uses_buffer() {
+        let (depth_state, interpolation) = self.state();
+        let pass = if depth_state.uses_buffer() {
             counters::add(Stage::DepthTests, u64::from(mask.count_ones()));
             let slot: &mut [f32; 8] = (&mut self.depth.data[start..start + 8])
                 .try_into()
                 .expect("8 lanes");
             let old = F::from_array(*slot);
-            let test = match self.opts.depth.func {
+            let test = match depth_state.func {
                 DepthFunc::Less => depth.lt(old).bitmask(),
                 DepthFunc::LessEqual => depth.le(old).bitmask(),
                 DepthFunc::Always => !0,
             };
             let pass = test & mask;
-            if pass != 0 && self.opts.depth.write {
+            if pass != 0 && depth_state.write {
                 let keep = F::I::from_bits(pass).cast_f32();
                 *slot = F::select(keep, depth, old).to_array();
             }
@@ -618,7 +636,7 @@ impl<S: Shader, C: ColorTarget, L: I32s> Fragments<'_, S, C, L> {
         if pass == 0 {
             return;
         }
-        let w = match self.opts.interpolation {
+        let w = match interpolation {
             Interpolation::Perspective => {
                 let iw = each3!(|e| F::splat(t.inv_w[e]));
                 let p = [b[0] * iw[0], b[1] * iw[1], b[2] * iw[2]];
@@ -655,7 +673,7 @@ fn span_weights8<V: Varying, F: F32s>(t: &Prepared<V>, n: u32, x0: u32, y: u32) 
 }
 
 /// Rasterizes the pieces of a draw's triangles.
-struct Raster<'a, S, C, L> {
+struct Raster<'a, S, C, L, const STD: bool> {
     shader: &'a S,
     depth: &'a mut DepthBuffer,
     color: &'a mut C,
@@ -665,10 +683,12 @@ struct Raster<'a, S, C, L> {
     lanes: PhantomData<L>,
 }
 
-impl<S: Shader, C: ColorTarget, L: I32s> EmitPiece<S::Varying> for Raster<'_, S, C, L> {
+impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> EmitPiece<S::Varying>
+    for Raster<'_, S, C, L, STD>
+{
     #[inline(always)]
     fn piece(&mut self, tri: &Prepared<S::Varying>) {
-        let mut frag = Fragments {
+        let mut frag = Fragments::<S, C, L, STD> {
             tri,
             shader: self.shader,
             depth: &mut *self.depth,
@@ -833,7 +853,31 @@ impl Renderer {
         let target = self.target;
         let mut projected = std::mem::take(&mut self.projected);
         project_vertices(cache, target, &mut projected);
-        let mut raster = Raster {
+        let std =
+            opts.depth == DepthState::default() && opts.interpolation == Interpolation::Perspective;
+        let stats = if std {
+            self.raster::<S, C, L, true>(shader, cache, &projected, indices, opts, color)
+        } else {
+            self.raster::<S, C, L, false>(shader, cache, &projected, indices, opts, color)
+        };
+        self.stats += stats;
+        self.projected = projected;
+    }
+
+    /// The triangle loop of [`Renderer::draw_triangles`] for one `STD` (see
+    /// [`Fragments`]).
+    #[inline(always)]
+    fn raster<S: Shader, C: ColorTarget, L: I32s, const STD: bool>(
+        &mut self,
+        shader: &S,
+        cache: &VertexCache<S::Varying>,
+        projected: &[Projected],
+        indices: &[u32],
+        opts: &DrawOptions,
+        color: &mut C,
+    ) -> DrawStats {
+        let target = self.target;
+        let mut raster = Raster::<S, C, L, STD> {
             shader,
             depth: &mut self.depth,
             color,
@@ -845,7 +889,7 @@ impl Renderer {
         let n = (indices.len() / 3) as u32;
         for t in 0..n {
             raster.stats.triangles += 1;
-            let proj = Some(projected.as_slice());
+            let proj = Some(projected);
             match prepare_projected(cache, proj, indices, t, target, opts.cull, &mut raster) {
                 PrepareOutcome::Rejected => raster.stats.rejected += 1,
                 PrepareOutcome::Culled => raster.stats.culled += 1,
@@ -855,8 +899,6 @@ impl Renderer {
                 }
             }
         }
-        let stats = raster.stats;
-        self.stats += stats;
-        self.projected = projected;
+        raster.stats
     }
 }

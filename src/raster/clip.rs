@@ -74,10 +74,11 @@ fn distances(p: Vec4, guard: [f32; 2]) -> [f32; 6] {
     ]
 }
 
-/// Outcode bits 0–5: the vertex lies outside clip plane 0–5 (near, far, then the
-/// guard band's −x… order of [`distances`]).
+/// Outcode bits 0–5: the vertex lies outside clip plane 0–5: near (`z < 0`), far
+/// (`z > w`), then the guard band's right, left, top and bottom (`x > g·w`,
+/// `x < −g·w`, `y > g·w`, `y < −g·w`).
 pub const OUT_PLANES: u8 = 0x3f;
-/// Outcode bit: `w ≤ 0` (or NaN).
+/// Outcode bit: `w ≤ 0`.
 pub const OUT_W_NOT_POSITIVE: u8 = 0x40;
 /// Outcode bit: a coordinate is NaN or infinite (no other bit is then set).
 pub const OUT_NOT_FINITE: u8 = 0x80;

@@ -484,6 +484,7 @@ fn setup_piece<V: Varying>(
         return Piece::Culled;
     }
     let order = |i: usize| if setup.flipped && i > 0 { 3 - i } else { i };
+    let var = each3!(|i| var[order(i)]);
     let (ox, oy) = (i64::from(setup.bbox.x0), i64::from(setup.bbox.y0));
     let edge_rem = each3!(|e| {
         let g = setup.reduced_edge(e, ox, oy);
@@ -497,11 +498,8 @@ fn setup_piece<V: Varying>(
         screen: each3!(|i| proj[order(i)].screen),
         z: each3!(|i| proj[order(i)].z),
         inv_w: each3!(|i| proj[order(i)].inv_w),
-        var: each3!(|i| var[order(i)]),
-        rel: {
-            let v = each3!(|i| var[order(i)]);
-            V::relative(&v[0], &v[1], &v[2])
-        },
+        rel: V::relative(&var[0], &var[1], &var[2]),
+        var,
         inv_area2: (1.0 / setup.area2 as f64) as f32,
         edge_rem,
     })

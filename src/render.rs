@@ -534,12 +534,12 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> CoverageSink
         let (depth_state, interpolation) = self.state();
         if depth_state.uses_buffer() {
             counters::add(Stage::DepthTests, 1);
-            let old = self.depth.data[i];
+            let old = self.depth.real_mut()[i];
             if !depth_state.func.passes(e.depth, old) {
                 return;
             }
             if depth_state.write {
-                self.depth.data[i] = e.depth;
+                self.depth.real_mut()[i] = e.depth;
             }
         }
         let v = self.tri.varyings(&e, interpolation);
@@ -580,10 +580,16 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
     /// The draw's depth state and interpolation: constants when `STD`.
     #[inline(always)]
     fn state(&self) -> (DepthState, Interpolation) {
+        Self::state_of(&self.opts)
+    }
+
+    /// [`Fragments::state`] of a draw's options.
+    #[inline(always)]
+    fn state_of(opts: &DrawOptions) -> (DepthState, Interpolation) {
         if STD {
             (DepthState::default(), Interpolation::Perspective)
         } else {
-            (self.opts.depth, self.opts.interpolation)
+            (opts.depth, opts.interpolation)
         }
     }
 
@@ -613,7 +619,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
         let (depth_state, interpolation) = self.state();
         let pass = if depth_state.uses_buffer() {
             counters::add(Stage::DepthTests, u64::from(mask.count_ones()));
-            let slot: &mut [f32; 8] = (&mut self.depth.data[start..start + 8])
+            let slot: &mut [f32; 8] = (&mut self.depth.real_mut()[start..start + 8])
                 .try_into()
                 .expect("8 lanes");
             let old = F::from_array(*slot);
@@ -686,6 +692,13 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> EmitPiece<S::Varying>
 {
     #[inline(always)]
     fn piece(&mut self, tri: &Prepared<S::Varying>) {
+        let (depth_state, _) = Fragments::<S, C, L, STD>::state_of(&self.opts);
+        if depth_state.uses_buffer() {
+            // Aligned groups overhang the box by at most 7 pixels, never into another
+            // tile (tiles are 16 wide and aligned).
+            let b = tri.setup.bbox;
+            self.depth.make_real(b.x0, b.y0, b.x1, b.y1);
+        }
         let mut frag = Fragments::<S, C, L, STD> {
             tri,
             shader: self.shader,
@@ -785,11 +798,7 @@ impl Renderer {
             self.depth.reset(target.width, target.height);
             counters::add(Stage::DepthClears, target.len() as u64);
         } else {
-            self.depth = DepthBuffer {
-                width: target.width,
-                height: target.height,
-                data: Vec::new(),
-            };
+            self.depth = DepthBuffer::empty(target.width, target.height);
         }
         color.reset(target.len(), background);
         self.stats = DrawStats::default();
@@ -798,7 +807,8 @@ impl Renderer {
     /// Whether this frame has a depth buffer.
     #[must_use]
     pub fn has_depth(&self) -> bool {
-        self.depth.data.len() == self.target.len()
+        self.depth.has_storage()
+            && (self.depth.width(), self.depth.height()) == (self.target.width, self.target.height)
     }
 
     /// Draws indexed triangles whose vertices are already in `cache` (see [`transform`]).

@@ -394,7 +394,10 @@ fn vertices_beyond_the_guard_band_are_clipped_not_lost() {
             img.0.iter().all(Option::is_some),
             "{far}: covers the target"
         );
-        assert!(r.depth.data.iter().all(|d| (d - 0.5).abs() < 1e-6), "{far}");
+        assert!(
+            r.depth.to_vec().iter().all(|d| (d - 0.5).abs() < 1e-6),
+            "{far}"
+        );
         for c in img.0.iter().flatten() {
             assert!(c.is_finite());
         }
@@ -525,7 +528,7 @@ fn vertices_behind_or_at_the_eye_never_leak() {
             );
             for (i, c) in img.0.iter().enumerate() {
                 if c.is_some() {
-                    let d = r.depth.data[i];
+                    let d = r.depth.at(i);
                     assert!(
                         d.is_finite() && (0.0..=1.0).contains(&d),
                         "{name}: depth {d}"
@@ -846,13 +849,13 @@ proptest! {
         transform(&shader, 3, &mut cache);
         let opts = DrawOptions { traversal, ..DrawOptions::default() };
         r.draw(&shader, &cache, &[0, 1, 2, 2, 1, 0], &opts, &mut out);
-        for (i, &d) in r.depth.data.iter().enumerate() {
+        for (i, &d) in r.depth.to_vec().iter().enumerate() {
             if out.0[i] != 0 {
                 prop_assert!((0.0..=1.0).contains(&d), "depth {d}");
             }
         }
         let p = probe(&cache, &[0, 1, 2, 2, 1, 0], target, &opts, px, py);
-        prop_assert_eq!(p.final_depth.to_bits(), r.depth.data[(py * 24 + px) as usize].to_bits());
+        prop_assert_eq!(p.final_depth.to_bits(), r.depth.at((py * 24 + px) as usize).to_bits());
     }
 
     /// Pass: arbitrary f64 bit patterns as 2D vertices never make a traversal report

@@ -221,7 +221,7 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
                 let i = (y * target.width + x) as usize;
                 assert_eq!(
                     p.final_depth.to_bits(),
-                    frame.renderer.depth.data[i].to_bits(),
+                    frame.renderer.depth.at(i).to_bits(),
                     "depth at ({x},{y})"
                 );
                 match p.winner {
@@ -281,7 +281,7 @@ fn traversals_and_instruction_sets_draw_identical_frames() {
         let depth: Vec<u32> = frame
             .renderer
             .depth
-            .data
+            .to_vec()
             .iter()
             .map(|d| d.to_bits())
             .collect();

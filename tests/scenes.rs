@@ -238,7 +238,7 @@ fn minimal_and_default_scenes() {
         Scene::from_text("[[object]]\nmodel = \"teapot\"\n", Path::new("m.toml")).unwrap();
     let mut f = SceneFrame::new(&minimal);
     f.draw(&minimal, Target::new(64, 48), &SceneView::default());
-    assert!(!f.renderer.has_depth() && f.renderer.depth.data.capacity() == 0);
+    assert!(!f.renderer.has_depth() && f.renderer.depth.capacity_bytes() == 0);
     let covered: Vec<_> = f.color.0.iter().filter(|p| p[3] == 255).collect();
     assert!(covered.len() > 200 && covered.iter().all(|p| p[..3] == [255, 255, 255]));
     let default = Scene::for_model("teapot").unwrap();

@@ -78,37 +78,260 @@ impl Default for DepthState {
 /// Value of a cleared depth buffer: the far plane.
 pub const DEPTH_CLEAR: f32 = 1.0;
 
-/// An f32 depth buffer.
-#[derive(Clone, Debug, PartialEq)]
+/// Width in pixels of a clear tile: one 64-byte cache line of depth values.
+pub const TILE_W: u32 = 16;
+/// Height in pixels of a clear tile.
+pub const TILE_H: u32 = 4;
+
+/// An f32 depth buffer, cleared lazily.
+///
+/// A clear only marks every `TILE_W × TILE_H` tile *stale* (one bit each): a stale
+/// tile reads as [`DEPTH_CLEAR`] whatever its memory holds. The renderer makes the
+/// tiles under a triangle's bounding box real ([`DepthBuffer::make_real`]) before it
+/// walks the triangle, so the far-plane values are written only where something is
+/// drawn, while those lines are being fetched anyway, instead of streaming the whole
+/// buffer through the cache every frame. Readers see the same values either way.
+#[derive(Clone, Debug, Default)]
 pub struct DepthBuffer {
-    pub width: u32,
-    pub height: u32,
-    pub data: Vec<f32>,
+    width: u32,
+    height: u32,
+    data: Vec<f32>,
+    /// One bit per tile, row-major, `words` 64-bit words per tile row.
+    stale: Vec<u64>,
+    words: usize,
+}
+
+impl PartialEq for DepthBuffer {
+    fn eq(&self, o: &Self) -> bool {
+        self.width == o.width && self.height == o.height && self.to_vec() == o.to_vec()
+    }
 }
 
 impl DepthBuffer {
     /// A cleared buffer.
     #[must_use]
     pub fn new(width: u32, height: u32) -> Self {
+        let mut d = Self::default();
+        d.reset(width, height);
+        d
+    }
+
+    /// A buffer of this size that holds no memory (see [`DepthBuffer::has_storage`]).
+    #[must_use]
+    pub fn empty(width: u32, height: u32) -> Self {
         Self {
             width,
             height,
-            data: vec![DEPTH_CLEAR; width as usize * height as usize],
+            ..Self::default()
         }
     }
 
-    /// Clears to the far plane, resizing only if the size changed.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Whether the buffer holds a value for every pixel (an [`DepthBuffer::empty`] one
+    /// does not).
+    #[must_use]
+    pub fn has_storage(&self) -> bool {
+        self.data.len() == self.width as usize * self.height as usize
+    }
+
+    /// Bytes of memory held.
+    #[must_use]
+    pub fn capacity_bytes(&self) -> usize {
+        self.data.capacity() * 4 + self.stale.capacity() * 8
+    }
+
+    /// Clears to the far plane (marks every tile stale), resizing only if the size
+    /// changed.
     pub fn reset(&mut self, width: u32, height: u32) {
         self.width = width;
         self.height = height;
-        self.data.clear();
-        self.data
-            .resize(width as usize * height as usize, DEPTH_CLEAR);
+        let len = width as usize * height as usize;
+        if self.data.len() != len {
+            // Contents are irrelevant: every tile is stale below.
+            self.data.clear();
+            self.data.resize(len, DEPTH_CLEAR);
+        }
+        let tiles_x = width.div_ceil(TILE_W) as usize;
+        let tiles_y = height.div_ceil(TILE_H) as usize;
+        self.words = tiles_x.div_ceil(64);
+        self.stale.clear();
+        // Only the bits of real tiles are set, so `resolve` never looks past the edge.
+        let row: Vec<u64> = (0..self.words)
+            .map(|w| {
+                let n = (tiles_x - w * 64).min(64);
+                if n == 64 { !0 } else { (1u64 << n) - 1 }
+            })
+            .collect();
+        for _ in 0..tiles_y {
+            self.stale.extend_from_slice(&row);
+        }
+    }
+
+    /// Whether the tile holding pixel `(x, y)` is stale.
+    #[inline(always)]
+    fn is_stale(&self, x: u32, y: u32) -> bool {
+        let (tx, ty) = ((x / TILE_W) as usize, (y / TILE_H) as usize);
+        self.stale[ty * self.words + tx / 64] >> (tx % 64) & 1 != 0
     }
 
     /// Depth at a pixel.
     #[must_use]
     pub fn get(&self, x: u32, y: u32) -> f32 {
-        self.data[y as usize * self.width as usize + x as usize]
+        if self.is_stale(x, y) {
+            DEPTH_CLEAR
+        } else {
+            self.data[y as usize * self.width as usize + x as usize]
+        }
+    }
+
+    /// Depth at row-major index `i`.
+    #[must_use]
+    pub fn at(&self, i: usize) -> f32 {
+        let w = self.width as usize;
+        self.get((i % w) as u32, (i / w) as u32)
+    }
+
+    /// Every value, row-major.
+    #[must_use]
+    pub fn to_vec(&self) -> Vec<f32> {
+        (0..self.data.len()).map(|i| self.at(i)).collect()
+    }
+
+    /// Makes every tile real, so the memory holds what [`DepthBuffer::get`] reads.
+    pub fn resolve(&mut self) {
+        let (w, h) = (self.width, self.height);
+        if self.has_storage() && w > 0 && h > 0 {
+            self.make_real(0, 0, w - 1, h - 1);
+        }
+    }
+
+    /// Makes the tiles overlapping pixels `x0..=x1` × `y0..=y1` real: stale ones are
+    /// filled with [`DEPTH_CLEAR`]. Costs a few word tests when they already are.
+    #[inline(always)]
+    pub fn make_real(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+        let (tx0, tx1) = ((x0 / TILE_W) as usize, (x1 / TILE_W) as usize);
+        for ty in (y0 / TILE_H) as usize..=(y1 / TILE_H) as usize {
+            for w in tx0 / 64..=tx1 / 64 {
+                let lo = if w == tx0 / 64 { tx0 % 64 } else { 0 };
+                let hi = if w == tx1 / 64 { tx1 % 64 } else { 63 };
+                let span = (!0u64 >> (63 - hi)) & (!0u64 << lo);
+                let word = &mut self.stale[ty * self.words + w];
+                let mut m = *word & span;
+                if m == 0 {
+                    continue;
+                }
+                *word &= !span;
+                while m != 0 {
+                    self.fill_tile(w * 64 + m.trailing_zeros() as usize, ty);
+                    m &= m - 1;
+                }
+            }
+        }
+    }
+
+    #[inline(never)]
+    fn fill_tile(&mut self, tx: usize, ty: usize) {
+        let w = self.width as usize;
+        let x0 = tx * TILE_W as usize;
+        let x1 = (x0 + TILE_W as usize).min(w);
+        let y0 = ty * TILE_H as usize;
+        for y in y0..(y0 + TILE_H as usize).min(self.height as usize) {
+            self.data[y * w + x0..y * w + x1].fill(DEPTH_CLEAR);
+        }
+    }
+
+    /// The values, row-major, for writers that made the tiles they touch real first.
+    #[inline(always)]
+    pub(crate) fn real_mut(&mut self) -> &mut [f32] {
+        &mut self.data
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    /// An operation on a buffer: clear, or make a box real and write a pixel in it.
+    #[derive(Clone, Debug)]
+    enum Op {
+        Reset,
+        Write {
+            x0: u32,
+            y0: u32,
+            x1: u32,
+            y1: u32,
+            at: (u32, u32),
+            z: f32,
+        },
+    }
+
+    fn op(w: u32, h: u32) -> impl Strategy<Value = Op> {
+        prop_oneof![
+            1 => Just(Op::Reset),
+            6 => (0..w, 0..h, 0..w, 0..h, 0.0f32..1.0, any::<u32>(), any::<u32>()).prop_map(
+                |(a, b, c, d, z, px, py)| {
+                    let (x0, x1, y0, y1) = (a.min(c), a.max(c), b.min(d), b.max(d));
+                    let at = (x0 + px % (x1 - x0 + 1), y0 + py % (y1 - y0 + 1));
+                    Op::Write { x0, y0, x1, y1, at, z }
+                }
+            ),
+        ]
+    }
+
+    proptest! {
+        /// The lazy buffer reads exactly like an eagerly cleared one, before and after
+        /// `resolve`, for sizes that are and are not multiples of the tile (and wider
+        /// than 64 tiles, so rows span several bit words).
+        #[test]
+        fn lazy_clear_reads_like_an_eager_clear(
+            (w, h, ops) in (1u32..1100, 1u32..20).prop_flat_map(|(w, h)| {
+                (Just(w), Just(h), proptest::collection::vec(op(w, h), 1..40))
+            })
+        ) {
+            let mut lazy = DepthBuffer::new(w, h);
+            let mut eager = vec![DEPTH_CLEAR; (w * h) as usize];
+            for op in &ops {
+                match *op {
+                    Op::Reset => {
+                        lazy.reset(w, h);
+                        eager.fill(DEPTH_CLEAR);
+                    }
+                    Op::Write { x0, y0, x1, y1, at, z } => {
+                        lazy.make_real(x0, y0, x1, y1);
+                        let i = (at.1 * w + at.0) as usize;
+                        lazy.real_mut()[i] = z;
+                        eager[i] = z;
+                    }
+                }
+                prop_assert_eq!(&lazy.to_vec(), &eager);
+            }
+            let (x, y) = (w / 2, h / 2);
+            prop_assert_eq!(lazy.get(x, y), eager[(y * w + x) as usize]);
+            lazy.resolve();
+            prop_assert_eq!(lazy.real_mut(), &eager[..]);
+        }
+    }
+
+    #[test]
+    fn a_clear_hides_the_previous_frame_and_resizes() {
+        let mut d = DepthBuffer::new(40, 9);
+        d.make_real(0, 0, 39, 8);
+        d.real_mut().fill(0.25);
+        d.reset(40, 9);
+        assert!(d.to_vec().iter().all(|&z| z == DEPTH_CLEAR));
+        d.reset(17, 5);
+        assert_eq!((d.width(), d.height(), d.to_vec().len()), (17, 5, 85));
+        assert!(d.has_storage() && !DepthBuffer::empty(17, 5).has_storage());
     }
 }

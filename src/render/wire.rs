@@ -141,7 +141,7 @@ pub fn draw_wireframe<V, C: ColorTarget>(
             h,
             |x, y| {
                 let i = y as usize * target.width as usize + x as usize;
-                let visible = depth.is_none_or(|d| sl.depth_at(k) - WIRE_DEPTH_BIAS <= d.data[i]);
+                let visible = depth.is_none_or(|d| sl.depth_at(k) - WIRE_DEPTH_BIAS <= d.at(i));
                 if visible {
                     color.put(i, wire);
                     written += 1;
@@ -194,7 +194,7 @@ pub fn probe_lines<V>(
         };
         let z = sl.depth_at(k);
         let i = y as usize * target.width as usize + x as usize;
-        let visible = depth.is_none_or(|d| z - WIRE_DEPTH_BIAS <= d.data[i]);
+        let visible = depth.is_none_or(|d| z - WIRE_DEPTH_BIAS <= d.at(i));
         hits.push(LineHit {
             edge: e,
             screen: sl,

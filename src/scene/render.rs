@@ -394,9 +394,9 @@ where
                 let m = (a + b) * 0.5;
                 let s = screen(m);
                 let (x, y) = ((s.x * side as f32) as u32, (s.y * side as f32) as u32);
-                if x < d.width && y < d.height {
+                if x < d.width() && y < d.height() {
                     let z = m.z / m.w;
-                    if z - WIRE_DEPTH_BIAS * 10.0 > d.data[(y * d.width + x) as usize] {
+                    if z - WIRE_DEPTH_BIAS * 10.0 > d.get(x, y) {
                         continue;
                     }
                 }

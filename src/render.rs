@@ -147,6 +147,12 @@ pub struct Prepared<V> {
     pub rel: [V; 3],
     /// `1 / area2`, rounded once to f32: barycentrics are `F · inv_area2`.
     pub inv_area2: f32,
+    /// Depth per unit of B's and C's edge value: `(z_B − z_A) / area2` and
+    /// `(z_C − z_A) / area2`, so depth is `z_A + F_B·zc[0] + F_C·zc[1]` (two fused
+    /// multiply-adds, exactly `z_A` at A).
+    pub zc: [f32; 2],
+    /// `(1/w_i) / area2` per vertex: the perspective numerators are `F_i · pc[i]`.
+    pub pc: [f32; 3],
     /// `F0e − 256·G0e` per edge (see [`Setup::reduced_edge`]): the same at every pixel,
     /// so `F0e = 256·G0e + edge_rem[e]` rebuilds the exact edge value from the lanes of
     /// the `wide` traversal.
@@ -154,18 +160,50 @@ pub struct Prepared<V> {
 }
 
 /// An edge value as the fragment stage sees it: `256·G + rem` in f32, from the reduced
-/// value `G` the traversal carries. Exact while `|G| < 2^24` (triangles up to a few
-/// hundred pixels across), one extra rounding beyond; the scalar and 8-lane paths
+/// value `G` the traversal carries. Exact while the result is below 2^24 (triangles up
+/// to a few thousand pixels across), one rounding beyond; the scalar and 8-lane paths
 /// both use this form, so they agree bit for bit.
 #[inline(always)]
 fn edge_value(g: f32, rem: f32) -> f32 {
-    g * 256.0 + rem
+    g.mul_add(256.0, rem)
 }
 
 /// [`edge_value`] on 8 lanes.
 #[inline(always)]
 fn edge_value8<F: F32s>(g: F, rem: f32) -> F {
-    g * F::splat(256.0) + F::splat(rem)
+    g.mul_add(F::splat(256.0), F::splat(rem))
+}
+
+/// Depth from the edge values `q` of A, B, C (see [`Prepared::zc`]), clamped to
+/// [0, 1] as a GPU clamps to its depth range: relative to A, rounding can land an ulp
+/// outside the vertices' range (a NaN stays NaN and fails every test).
+#[inline(always)]
+fn depth_of(q: [f32; 3], z_a: f32, zc: [f32; 2]) -> f32 {
+    let d = q[2].mul_add(zc[1], q[1].mul_add(zc[0], z_a));
+    // `max`/`min` of the lanes, spelled out: the second operand wins unless the
+    // comparison holds, so NaN passes through.
+    let d = if 0.0 > d { 0.0 } else { d };
+    if 1.0 < d { 1.0 } else { d }
+}
+
+/// [`depth_of`] on 8 lanes.
+#[inline(always)]
+fn depth_of8<F: F32s>(q: [F; 3], z_a: f32, zc: [f32; 2]) -> F {
+    let d = q[2].mul_add(
+        F::splat(zc[1]),
+        q[1].mul_add(F::splat(zc[0]), F::splat(z_a)),
+    );
+    F::splat(1.0).min(F::splat(0.0).max(d))
+}
+
+/// [`perspective_weights`] on 8 lanes.
+#[inline(always)]
+fn perspective_weights8<F: F32s>(q: [F; 3], pc: [f32; 3]) -> [F; 3] {
+    let c = each3!(|i| F::splat(pc[i]));
+    let p = [q[0] * c[0], q[1] * c[1], q[2] * c[2]];
+    let s = q[2].mul_add(c[2], q[1].mul_add(c[1], p[0]));
+    let r = F::splat(1.0) / s;
+    [p[0] * r, p[1] * r, p[2] * r]
 }
 
 /// The state of one pixel of one triangle: what the renderer computes per fragment.
@@ -201,9 +239,11 @@ impl<V: Varying> Prepared<V> {
         let f03 = s.area2 - f01 - f02;
         let f = [f01, f02, f03];
         let covered = (0..3).all(|e| f[e] + s.bias[e] >= 0);
-        let bary = self.bary_of(f);
-        let depth = bary[0] * self.z[0] + bary[1] * self.z[1] + bary[2] * self.z[2];
-        let (persp, inv_w) = perspective_weights(bary, self.inv_w);
+        let q = self.vertex_edges(f);
+        let ia = self.inv_area2;
+        let bary = [q[0] * ia, q[1] * ia, q[2] * ia];
+        let depth = depth_of(q, self.z[0], self.zc);
+        let (persp, inv_w) = perspective_weights(q, self.pc);
         PixelEval {
             x,
             y,
@@ -216,17 +256,17 @@ impl<V: Varying> Prepared<V> {
         }
     }
 
-    /// Screen-space barycentrics from raw edge values, by the same f32 operations in
-    /// the same order as the 8-lane fragment loop (so both give identical bits).
+    /// The edge values weighing A, B and C (`F02`, `F03`, `F01`: each vertex's weight
+    /// is the edge opposite it) from raw edge values, by the same f32 operations as the
+    /// 8-lane fragment loop (so both give identical bits).
     #[inline(always)]
-    fn bary_of(&self, f: [i64; 3]) -> [f32; 3] {
+    fn vertex_edges(&self, f: [i64; 3]) -> [f32; 3] {
         let s = &self.setup;
         let fl = each3!(|e| {
             let g = (f[e] + s.bias[e]) >> SUBPIXEL_BITS;
             edge_value(g as f32, self.edge_rem[e])
         });
-        let ia = self.inv_area2;
-        [fl[1] * ia, fl[2] * ia, fl[0] * ia]
+        [fl[1], fl[2], fl[0]]
     }
 
     /// Perspective-correct weights at the centre of pixel `(x, y)`, which may lie
@@ -490,17 +530,24 @@ fn setup_piece<V: Varying>(
         let g = setup.reduced_edge(e, ox, oy);
         (setup.edge_raw(e, ox, oy) - (g << SUBPIXEL_BITS)) as f32
     });
+    let z = each3!(|i| proj[order(i)].z);
+    let inv_w = each3!(|i| proj[order(i)].inv_w);
+    // In f64, rounded once: the per-pixel terms then carry one rounding each.
+    let a2 = setup.area2 as f64;
+    let zc = [1, 2].map(|i| ((f64::from(z[i]) - f64::from(z[0])) / a2) as f32);
     Piece::Drawn(Prepared {
         triangle: t,
         piece: piece as u8,
         clipped,
         setup,
         screen: each3!(|i| proj[order(i)].screen),
-        z: each3!(|i| proj[order(i)].z),
-        inv_w: each3!(|i| proj[order(i)].inv_w),
+        z,
+        inv_w,
+        zc,
+        pc: each3!(|i| (f64::from(inv_w[i]) / a2) as f32),
         rel: V::relative(&var[0], &var[1], &var[2]),
         var,
-        inv_area2: (1.0 / setup.area2 as f64) as f32,
+        inv_area2: (1.0 / a2) as f32,
         edge_rem,
     })
 }
@@ -611,10 +658,8 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
         let t = self.tri;
         let start = y as usize * self.width + x0 as usize;
         let fl = each3!(|e| edge_value8(g[e], t.edge_rem[e]));
-        let ia = F::splat(t.inv_area2);
-        let b = [fl[1] * ia, fl[2] * ia, fl[0] * ia];
-        let z = each3!(|e| F::splat(t.z[e]));
-        let depth = b[0] * z[0] + b[1] * z[1] + b[2] * z[2];
+        let q = [fl[1], fl[2], fl[0]];
+        let depth = depth_of8(q, t.z[0], t.zc);
         self.fragments += u64::from(mask.count_ones());
         let (depth_state, interpolation) = self.state();
         let pass = if depth_state.uses_buffer() {
@@ -641,13 +686,11 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
             return;
         }
         let w = match interpolation {
-            Interpolation::Perspective => {
-                let iw = each3!(|e| F::splat(t.inv_w[e]));
-                let p = [b[0] * iw[0], b[1] * iw[1], b[2] * iw[2]];
-                let r = F::splat(1.0) / (p[0] + p[1] + p[2]);
-                [p[0] * r, p[1] * r, p[2] * r]
+            Interpolation::Perspective => perspective_weights8(q, t.pc),
+            Interpolation::Affine => {
+                let ia = F::splat(t.inv_area2);
+                [q[0] * ia, q[1] * ia, q[2] * ia]
             }
-            Interpolation::Affine => b,
             mode => span_weights8(t, mode.span().unwrap_or(8), x0, y),
         };
         let colors = self.shader.fragment8(&t.rel, &w, pass);
@@ -717,14 +760,15 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> EmitPiece<S::Varying>
 }
 
 /// Which instructions the draw loop is compiled for. Both give identical bits: only
-/// instruction selection differs, no operation is fused or reordered.
+/// instruction selection differs (fused multiply-adds are written as such and are
+/// correctly rounded on both), nothing is reordered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
     /// The build's target (baseline x86-64: 8-lane types run as two SSE halves).
     Baseline,
-    /// x86-64 with AVX2 (and the POPCNT and BMI1 that every AVX2 CPU has, for the
-    /// per-group fragment counts and lane loops), chosen at run time when the CPU has
-    /// them.
+    /// x86-64 with AVX2 and FMA (and the POPCNT and BMI1 that every AVX2 CPU has, for
+    /// the per-group fragment counts and lane loops), chosen at run time when the CPU
+    /// has them.
     Avx2,
 }
 
@@ -744,6 +788,7 @@ impl Isa {
         #[cfg(target_arch = "x86_64")]
         {
             std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("fma")
                 && std::arch::is_x86_feature_detected!("popcnt")
                 && std::arch::is_x86_feature_detected!("bmi1")
         }
@@ -825,19 +870,20 @@ impl Renderer {
         }
         #[cfg(target_arch = "x86_64")]
         if self.isa == Isa::Avx2 && Isa::has_avx2() {
-            // SAFETY: the CPU has AVX2, POPCNT and BMI1, checked just above.
+            // SAFETY: the CPU has AVX2, FMA, POPCNT and BMI1, checked just above.
             unsafe { self.draw_avx2(shader, cache, indices, opts, color) };
             return;
         }
         self.draw_triangles::<_, _, wide::i32x8>(shader, cache, indices, opts, color);
     }
 
-    /// The draw loop compiled with AVX2 enabled and on [`crate::simd`]'s AVX2 lanes,
-    /// so 8-lane values are one 256-bit register instead of two 128-bit halves. Only
-    /// the instruction selection differs: no operation is fused or reordered, so the
-    /// output is bit-identical to the baseline path (the tests compare both).
+    /// The draw loop compiled with AVX2 and FMA enabled and on [`crate::simd`]'s AVX2
+    /// lanes, so 8-lane values are one 256-bit register instead of two 128-bit halves
+    /// and `mul_add` is one instruction. Only the instruction selection differs: no
+    /// operation is fused or reordered beyond what the code says, so the output is
+    /// bit-identical to the baseline path (the tests compare both).
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,popcnt,bmi1")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1")]
     unsafe fn draw_avx2<S: Shader, C: ColorTarget>(
         &mut self,
         shader: &S,

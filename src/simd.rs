@@ -11,9 +11,14 @@
 //! with AVX2 enabled at run time still gets its SSE halves; these traits let that
 //! function use 256-bit registers instead.
 //!
-//! Both backends perform the same IEEE operations lane by lane, with no fused
-//! multiply-add and no reassociation, so they give identical bits (the tests compare
-//! whole frames). Masks are lanes of all ones or all zeros.
+//! Both backends perform the same IEEE operations lane by lane, with no reassociation,
+//! so they give identical bits (the tests compare whole frames). Fused multiply-add is
+//! one of those operations ([`F32s::mul_add`], one rounding): one instruction on the
+//! AVX2 path (which requires FMA, as every AVX2 CPU has it), the correctly rounded
+//! `f32::mul_add` lane by lane on the baseline. (The one exception is which NaN payload
+//! a fused multiply-add of NaNs keeps, which x86 ties to the operand order the compiler
+//! picks; no output depends on it: NaN fails every depth test and clamps to 0 in
+//! colour.) Masks are lanes of all ones or all zeros.
 
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Sub};
 
@@ -55,6 +60,8 @@ pub trait F32s:
     fn to_array(self) -> [f32; 8];
     /// Correctly rounded square root.
     fn sqrt(self) -> Self;
+    /// `self · b + c` rounded once (IEEE fusedMultiplyAdd), as `f32::mul_add`.
+    fn mul_add(self, b: Self, c: Self) -> Self;
     /// Mask of `self > o` (false for NaN).
     fn gt(self, o: Self) -> Self;
     /// Mask of `self < o` (false for NaN).
@@ -118,6 +125,12 @@ impl F32s for f32x8 {
     #[inline(always)]
     fn sqrt(self) -> Self {
         f32x8::sqrt(self)
+    }
+    #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        // Not `wide`'s `mul_add`: without FMA in the build's target it rounds twice.
+        let (a, b, c) = (self.to_array(), b.to_array(), c.to_array());
+        f32x8::new(std::array::from_fn(|i| a[i].mul_add(b[i], c[i])))
     }
     #[inline(always)]
     fn gt(self, o: Self) -> Self {
@@ -196,7 +209,7 @@ impl I32s for i32x8 {
 
 /// The AVX2 backend.
 ///
-/// Its values may only exist on a CPU with AVX2: the types are crate-private and
+/// Its values may only exist on a CPU with AVX2 and FMA: the types are crate-private and
 /// instantiated only by the renderer's AVX2 draw loop, which checks the CPU first.
 /// Their methods are `#[inline(always)]` without target features of their own, so the
 /// intrinsics inline into that loop (which has the features) as single instructions.
@@ -221,7 +234,7 @@ pub(crate) mod avx2 {
                 type Output = $t;
                 #[inline(always)]
                 fn $f(self, o: $t) -> $t {
-                    // SAFETY: values of this type exist only on CPUs with AVX2 (module docs).
+                    // SAFETY: values of this type exist only on CPUs with AVX2 and FMA (module docs).
                     $t(unsafe { $intr(self.0, o.0) })
                 }
             }
@@ -236,7 +249,7 @@ pub(crate) mod avx2 {
     binop!(I32x8, BitAnd, bitand, _mm256_and_si256);
 
     // SAFETY (every `unsafe` block below): values of these types exist only on CPUs
-    // with AVX2 (module docs); loads and stores go through arrays of exactly 8 lanes.
+    // with AVX2 and FMA (module docs); loads and stores go through arrays of exactly 8 lanes.
     impl F32s for F32x8 {
         type I = I32x8;
         #[inline(always)]
@@ -256,6 +269,10 @@ pub(crate) mod avx2 {
         #[inline(always)]
         fn sqrt(self) -> Self {
             F32x8(unsafe { _mm256_sqrt_ps(self.0) })
+        }
+        #[inline(always)]
+        fn mul_add(self, b: Self, c: Self) -> Self {
+            F32x8(unsafe { _mm256_fmadd_ps(self.0, b.0, c.0) })
         }
         #[inline(always)]
         fn gt(self, o: Self) -> Self {
@@ -353,6 +370,12 @@ mod tests {
         push(x * y);
         push(x / y);
         push(x.sqrt());
+        // Which NaN's payload a fused multiply-add keeps depends on the operand order
+        // the compiler picks; only NaN-ness is compared (see the module docs).
+        let canon =
+            |v: F| F::from_array(v.to_array().map(|f| if f.is_nan() { f32::NAN } else { f }));
+        push(canon(x.mul_add(y, F::from_array(a.map(|v| v * 0.75)))));
+        push(canon(y.mul_add(y, x)));
         push(x.gt(y));
         push(x.lt(y));
         push(x.le(y));
@@ -395,7 +418,7 @@ mod tests {
         ) {
             // Without AVX2 there is no second backend to compare (and `prop_assume!`
             // would reject every case and fail the run).
-            if !std::arch::is_x86_feature_detected!("avx2") {
+            if !crate::render::Isa::has_avx2() {
                 return Ok(());
             }
             let base = ops::<f32x8>(a, b, m, k);

@@ -18,7 +18,7 @@ use termrast::accuracy::edge::EdgeArith;
 use termrast::camera::Camera;
 use termrast::raster::clip::{ClipOutcome, classify_codes, guard_band_ndc, outcode};
 use termrast::raster::depth::{DepthFunc, DepthState};
-use termrast::raster::interp::perspective_weights;
+use termrast::raster::interp::Interpolation;
 use termrast::raster::line::{Line, NoTrace};
 use termrast::raster::probe::probe;
 use termrast::raster::traverse::seed_simd_lanes;
@@ -734,9 +734,14 @@ fn perspective_weights_stay_exact_in_small_triangles_far_from_the_origin() {
                     checked += 1;
                 }
             }
-            // At a vertex the weights are exactly that vertex's.
-            let (w, _) = perspective_weights([1.0, 0.0, 0.0], p.inv_w);
-            assert_eq!(w, [1.0, 0.0, 0.0]);
+            // Vertex A sits on the centre of pixel (65000, 65000) (which the fill rule
+            // leaves to a neighbour, but the weights are defined there): the other two
+            // vertices' weights are exactly 0, so every varying is exactly A's.
+            let e = p.eval(65_000, 65_000);
+            assert_eq!((e.f[1], e.f[2]), (p.setup.area2, 0));
+            assert_eq!((e.persp[1], e.persp[2]), (0.0, 0.0));
+            assert!((e.persp[0] - 1.0).abs() < 1e-6, "{:?}", e.persp);
+            assert_eq!(p.varyings(&e, Interpolation::Perspective), Vec3::X);
         },
     );
     assert!(checked >= 3, "{checked}");

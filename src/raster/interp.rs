@@ -25,13 +25,38 @@ pub trait Varying: Copy {
     /// per triangle instead of once per pixel.
     fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3];
 
-    /// `r[0] + r[1]·w[1] + r[2]·w[2]` for `r` from [`Varying::relative`]: exactly
-    /// [`Varying::weighted`] of the vertices `r` came from.
+    /// `r[0] + r[1]·w[1] + r[2]·w[2]` (as two fused multiply-adds, inner first) for `r`
+    /// from [`Varying::relative`]: exactly [`Varying::weighted`] of the vertices `r`
+    /// came from.
     fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self;
 
     /// `a + (b − a)·t`, used by clipping (linear in clip space).
     fn lerp(a: &Self, b: &Self, t: f32) -> Self;
 }
+
+/// A weight as the multiplier of a varying type: itself for `f32`, splatted for vectors.
+trait Weight {
+    fn weight(w: f32) -> Self;
+}
+
+impl Weight for f32 {
+    #[inline(always)]
+    fn weight(w: f32) -> Self {
+        w
+    }
+}
+
+macro_rules! vector_weight {
+    ($($t:ty),*) => {$(
+        impl Weight for $t {
+            #[inline(always)]
+            fn weight(w: f32) -> Self {
+                <$t>::splat(w)
+            }
+        }
+    )*};
+}
+vector_weight!(Vec2, Vec3, Vec4);
 
 macro_rules! vector_varying {
     ($($t:ty),*) => {$(
@@ -42,7 +67,8 @@ macro_rules! vector_varying {
             }
             #[inline(always)]
             fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
-                r[0] + r[1] * w[1] + r[2] * w[2]
+                // Fused: one rounding per term (a shader's `fragment8` repeats this).
+                r[2].mul_add(Self::weight(w[2]), r[1].mul_add(Self::weight(w[1]), r[0]))
             }
             #[inline(always)]
             fn lerp(a: &Self, b: &Self, t: f32) -> Self {
@@ -159,14 +185,16 @@ pub fn span_lerp(wa: [f32; 3], wb: [f32; 3], t: f32) -> [f32; 3] {
     ]
 }
 
-/// Perspective-correct weights from screen-space barycentrics `b` and each vertex's
-/// `1/w`, plus the interpolated `1/w` itself.
+/// Perspective-correct weights (eq. 23) from the edge values `q` weighing each vertex
+/// and `c[i] = (1/w_i) / area2`, plus the interpolated `1/w` itself: `p_i = q_i·c_i`
+/// is `b_i/w_i`, and the weights are `p_i / Σ p_j`. The sum is of non-negative terms
+/// inside the triangle, so it never cancels.
 #[must_use]
 #[inline(always)]
-pub fn perspective_weights(b: [f32; 3], inv_w: [f32; 3]) -> ([f32; 3], f32) {
+pub fn perspective_weights(q: [f32; 3], c: [f32; 3]) -> ([f32; 3], f32) {
     // Same operations, same order, as the renderer's 8-lane path.
-    let p = [b[0] * inv_w[0], b[1] * inv_w[1], b[2] * inv_w[2]];
-    let s = p[0] + p[1] + p[2];
+    let p = [q[0] * c[0], q[1] * c[1], q[2] * c[2]];
+    let s = q[2].mul_add(c[2], q[1].mul_add(c[1], p[0]));
     let r = 1.0 / s;
     ([p[0] * r, p[1] * r, p[2] * r], s)
 }

@@ -56,29 +56,34 @@ impl Shader for Lambert<'_> {
     #[inline(always)]
     fn fragment(&self, n: &Vec3) -> Vec3 {
         // Normalise after interpolation (interpolated unit vectors are shorter than 1):
-        // l = max(n·L / |n|, 0). Written out so `fragment8` can repeat it bit for bit.
-        let len = (n.x * n.x + n.y * n.y + n.z * n.z).sqrt();
-        let d = n.x * self.light.x + n.y * self.light.y + n.z * self.light.z;
+        // l = max(n·L / |n|, 0). Written out, with fused multiply-adds, so `fragment8`
+        // can repeat it bit for bit.
+        let lt = self.light;
+        let len = n.z.mul_add(n.z, n.y.mul_add(n.y, n.x * n.x)).sqrt();
+        let d = n.z.mul_add(lt.z, n.y.mul_add(lt.y, n.x * lt.x));
         let l = d / len;
         let l = if l > 0.0 { l } else { 0.0 };
-        let k = self.ambient + (1.0 - self.ambient) * l;
+        let k = l.mul_add(1.0 - self.ambient, self.ambient);
         self.base * k
     }
 
     #[inline(always)]
     fn fragment8<F: F32s>(&self, rel: &[Vec3; 3], w: &[F; 3], _mask: u8) -> [F; 3] {
-        // `Varying::from_relative` lane by lane: a + (b − a)·w1 + (c − a)·w2.
+        // `Varying::from_relative` lane by lane: a + (b − a)·w1 + (c − a)·w2, fused.
         let [a, ba, ca] = rel;
-        let [x, y, z] =
-            each3!(|i| F::splat(a[i]) + F::splat(ba[i]) * w[1] + F::splat(ca[i]) * w[2]);
-        let len = (x * x + y * y + z * z).sqrt();
+        let [x, y, z] = each3!(
+            |i| F::splat(ca[i]).mul_add(w[2], F::splat(ba[i]).mul_add(w[1], F::splat(a[i])))
+        );
+        let len = z.mul_add(z, y.mul_add(y, x * x)).sqrt();
         let lt = self.light;
-        let d = x * F::splat(lt.x) + y * F::splat(lt.y) + z * F::splat(lt.z);
+        let d = z.mul_add(
+            F::splat(lt.z),
+            y.mul_add(F::splat(lt.y), x * F::splat(lt.x)),
+        );
         let l = d / len;
         // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
         let l = l.max(F::splat(0.0));
-        let a = F::splat(self.ambient);
-        let k = a + F::splat(1.0 - self.ambient) * l;
+        let k = l.mul_add(F::splat(1.0 - self.ambient), F::splat(self.ambient));
         each3!(|i| F::splat(self.base[i]) * k)
     }
 }

@@ -533,8 +533,8 @@ fn setup_piece<V: Varying>(
     let z = each3!(|i| proj[order(i)].z);
     let inv_w = each3!(|i| proj[order(i)].inv_w);
     // In f64, rounded once: the per-pixel terms then carry one rounding each.
-    let a2 = setup.area2 as f64;
-    let zc = [1, 2].map(|i| ((f64::from(z[i]) - f64::from(z[0])) / a2) as f32);
+    let ia = 1.0 / setup.area2 as f64;
+    let zc = [1, 2].map(|i| ((f64::from(z[i]) - f64::from(z[0])) * ia) as f32);
     Piece::Drawn(Prepared {
         triangle: t,
         piece: piece as u8,
@@ -544,10 +544,10 @@ fn setup_piece<V: Varying>(
         z,
         inv_w,
         zc,
-        pc: each3!(|i| (f64::from(inv_w[i]) / a2) as f32),
+        pc: each3!(|i| (f64::from(inv_w[i]) * ia) as f32),
         rel: V::relative(&var[0], &var[1], &var[2]),
         var,
-        inv_area2: (1.0 / a2) as f32,
+        inv_area2: ia as f32,
         edge_rem,
     })
 }

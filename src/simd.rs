@@ -81,7 +81,9 @@ pub trait F32s:
 }
 
 /// Eight `i32` lanes.
-pub trait I32s: Copy + Add<Output = Self> + BitOr<Output = Self> + BitAnd<Output = Self> {
+pub trait I32s:
+    Copy + Add<Output = Self> + Mul<Output = Self> + BitOr<Output = Self> + BitAnd<Output = Self>
+{
     /// The float lanes of the same backend.
     type F: F32s<I = Self>;
     fn splat(v: i32) -> Self;
@@ -245,6 +247,7 @@ pub(crate) mod avx2 {
     binop!(F32x8, Mul, mul, _mm256_mul_ps);
     binop!(F32x8, Div, div, _mm256_div_ps);
     binop!(I32x8, Add, add, _mm256_add_epi32);
+    binop!(I32x8, Mul, mul, _mm256_mullo_epi32);
     binop!(I32x8, BitOr, bitor, _mm256_or_si256);
     binop!(I32x8, BitAnd, bitand, _mm256_and_si256);
 
@@ -386,6 +389,7 @@ mod tests {
         let i = F::I::from_array(k);
         push(i.to_f32());
         push(((i + i.shl::<8>()) | (F::I::splat(7) & i)).cast_f32());
+        push((i * F::I::splat(-77_777)).cast_f32());
         push(F::I::select(i.eq(F::I::splat(3)), i, F::I::from_bits(m)).cast_f32());
         // Truncation only where it is defined (the colour stores clamp first).
         let t = F::select(x.lt(F::splat(1e9)), x, F::splat(0.0));

@@ -18,8 +18,10 @@ trait Lanes: Copy {
 impl<L: I32s> Lanes for L {
     #[inline(always)]
     fn ramp(base: i64, step: i64) -> Self {
-        // Exact: `fits_i32` bounded every lane value before this path was chosen.
-        L::from_array(std::array::from_fn(|i| (base + i as i64 * step) as i32))
+        // Exact: `fits_i32` bounded every lane value before this path was chosen (and
+        // wrapping i32 arithmetic agrees with i64 on values that fit).
+        let iota = L::from_array([0, 1, 2, 3, 4, 5, 6, 7]);
+        L::splat(base as i32) + iota * L::splat(step as i32)
     }
     #[inline(always)]
     fn splat(v: i64) -> Self {

@@ -717,6 +717,7 @@ fn perspective_weights_stay_exact_in_small_triangles_far_from_the_origin() {
             for y in s.bbox.y0..=s.bbox.y1 {
                 for x in s.bbox.x0..=s.bbox.x1 {
                     let e = p.eval(x, y);
+                    assert_eq!(p.depth_at(x, y).to_bits(), e.depth.to_bits());
                     if !e.covered {
                         continue;
                     }

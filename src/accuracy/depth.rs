@@ -226,7 +226,7 @@ impl CoverageSink for Sink<'_> {
     #[inline]
     fn pixel(&mut self, x: u32, y: u32) {
         let Some(t) = &self.tri else { return };
-        let z = t.eval(x, y).depth;
+        let z = t.depth_at(x, y);
         let i = y as usize * self.width + x as usize;
         self.fragments += 1;
         if self.storage.test_and_set(i, z) {

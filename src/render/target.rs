@@ -36,7 +36,9 @@ pub struct Rgba8(pub Vec<[u8; 4]>);
 #[must_use]
 #[inline(always)]
 pub fn to_u8(v: f32) -> u8 {
-    v.clamp(0.0, 1.0).mul_add(255.0, 0.5) as u8
+    // Not fused: this also runs outside the FMA-compiled draw loop (wireframes), where
+    // a fused multiply-add is a library call per channel.
+    (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
 
 /// [`to_u8`] on 8 lanes, bit for bit (NaN gives 0 in both).
@@ -45,7 +47,7 @@ pub fn to_u8(v: f32) -> u8 {
 pub fn to_u8x8<F: F32s>(v: F) -> F::I {
     // max(NaN, 0) is 0, as NaN's `as u8` is in `to_u8`.
     let v = v.max(F::splat(0.0)).min(F::splat(1.0));
-    v.mul_add(F::splat(255.0), F::splat(0.5)).trunc_i32()
+    (v * F::splat(255.0) + F::splat(0.5)).trunc_i32()
 }
 
 impl ColorTarget for Rgba8 {

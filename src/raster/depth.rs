@@ -1,7 +1,9 @@
 //! The depth buffer.
 //!
 //! **Convention: depth is NDC z in [0, 1], 0 at the near plane, 1 at the far plane;
-//! smaller is nearer.** The buffer clears to 1.0 and the default test is `Less`.
+//! smaller is nearer.** The buffer clears to 1.0 (lazily, per tile: see
+//! [`DepthBuffer`]), the default test is `Less`, and interpolated depth is clamped to
+//! [0, 1] before the test, as a GPU clamps to its depth range.
 //!
 //! Seed 000's pseudo code stores `Depth = 1 / (1/z)` (the view distance) and writes when
 //! `DepthBuffer < Depth`, which keeps the *farthest* surface: the comparison only makes

@@ -234,12 +234,7 @@ impl<V: Varying> Prepared<V> {
     #[must_use]
     pub fn eval(&self, x: u32, y: u32) -> PixelEval {
         let s = &self.setup;
-        let (xi, yi) = (i64::from(x), i64::from(y));
-        let f01 = s.edge_raw(0, xi, yi);
-        let f02 = s.edge_raw(1, xi, yi);
-        // Exact: the three edge functions sum to the doubled area everywhere.
-        let f03 = s.area2 - f01 - f02;
-        let f = [f01, f02, f03];
+        let f = self.raw_edges(x, y);
         let covered = (0..3).all(|e| f[e] + s.bias[e] >= 0);
         let q = self.vertex_edges(f);
         let ia = self.inv_area2;
@@ -262,12 +257,19 @@ impl<V: Varying> Prepared<V> {
     #[inline(always)]
     #[must_use]
     pub fn depth_at(&self, x: u32, y: u32) -> f32 {
+        let q = self.vertex_edges(self.raw_edges(x, y));
+        depth_of(q, self.z[0], self.zc)
+    }
+
+    /// Raw `F01, F02, F03` at the centre of pixel `(x, y)`.
+    #[inline(always)]
+    fn raw_edges(&self, x: u32, y: u32) -> [i64; 3] {
         let s = &self.setup;
         let (xi, yi) = (i64::from(x), i64::from(y));
         let f01 = s.edge_raw(0, xi, yi);
         let f02 = s.edge_raw(1, xi, yi);
-        let q = self.vertex_edges([f01, f02, s.area2 - f01 - f02]);
-        depth_of(q, self.z[0], self.zc)
+        // Exact: the three edge functions sum to the doubled area everywhere.
+        [f01, f02, s.area2 - f01 - f02]
     }
 
     /// The edge values weighing A, B and C (`F02`, `F03`, `F01`: each vertex's weight

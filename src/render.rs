@@ -435,29 +435,26 @@ pub fn prepare_projected<V: Varying>(
     emit: &mut impl EmitPiece<V>,
 ) -> PrepareOutcome {
     let base = t as usize * 3;
-    let Some(tri) = indices.get(base..base + 3) else {
+    let Some(idx) = indices.get(base..base + 3) else {
         return PrepareOutcome::Rejected;
     };
     let fetch = |i: u32| cache.verts.get(i as usize).copied();
-    let (Some(a), Some(b), Some(c)) = (fetch(tri[0]), fetch(tri[1]), fetch(tri[2])) else {
+    let (Some(a), Some(b), Some(c)) = (fetch(idx[0]), fetch(idx[1]), fetch(idx[2])) else {
         return PrepareOutcome::Rejected;
     };
+    let tri = [a, b, c];
     let guard = guard_band_ndc(target.width, target.height);
     let proj = match projected {
         Some(p) => match (
-            p.get(tri[0] as usize),
-            p.get(tri[1] as usize),
-            p.get(tri[2] as usize),
+            p.get(idx[0] as usize),
+            p.get(idx[1] as usize),
+            p.get(idx[2] as usize),
         ) {
             (Some(&pa), Some(&pb), Some(&pc)) => [pa, pb, pc],
             _ => return PrepareOutcome::Rejected,
         },
-        None => {
-            let v = [a, b, c];
-            each3!(|i| Projected::of(v[i].pos, target, guard))
-        }
+        None => each3!(|i| Projected::of(tri[i].pos, target, guard)),
     };
-    let tri = [a, b, c];
     let outcome = classify_codes(each3!(|i| proj[i].out));
     let clipped = outcome == ClipOutcome::Clipped;
     let mut seen = Seen::default();
@@ -529,7 +526,8 @@ fn setup_piece<V: Varying>(
     target: Target,
     cull: Cull,
 ) -> Piece<V> {
-    if !proj.iter().all(|p| p.snapped) {
+    // Not `iter().all(..)`: it stays out of line in the AVX2 draw loop.
+    if !(proj[0].snapped && proj[1].snapped && proj[2].snapped) {
         return Piece::Rejected;
     }
     let Ok(setup) = Setup::from_fixed(each3!(|i| proj[i].fixed), target) else {
@@ -550,7 +548,8 @@ fn setup_piece<V: Varying>(
     let inv_w = each3!(|i| proj[order(i)].inv_w);
     // In f64, rounded once: the per-pixel terms then carry one rounding each.
     let ia = 1.0 / setup.area2 as f64;
-    let zc = [1, 2].map(|i| ((f64::from(z[i]) - f64::from(z[0])) * ia) as f32);
+    let slope = |i: usize| ((f64::from(z[i]) - f64::from(z[0])) * ia) as f32;
+    let zc = [slope(1), slope(2)];
     Piece::Drawn(Prepared {
         triangle: t,
         piece: piece as u8,

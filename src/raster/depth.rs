@@ -165,17 +165,14 @@ impl DepthBuffer {
         let tiles_x = width.div_ceil(TILE_W) as usize;
         let tiles_y = height.div_ceil(TILE_H) as usize;
         self.words = tiles_x.div_ceil(64);
-        self.stale.clear();
         // Only the bits of real tiles are set, so `resolve` never looks past the edge.
-        let row: Vec<u64> = (0..self.words)
-            .map(|w| {
-                let n = (tiles_x - w * 64).min(64);
-                if n == 64 { !0 } else { (1u64 << n) - 1 }
-            })
-            .collect();
-        for _ in 0..tiles_y {
-            self.stale.extend_from_slice(&row);
-        }
+        // Refilled in place: a steady viewer allocates nothing here.
+        let words = self.words;
+        self.stale.clear();
+        self.stale.extend((0..tiles_y * words).map(|i| {
+            let n = (tiles_x - i % words * 64).min(64);
+            if n == 64 { !0 } else { (1u64 << n) - 1 }
+        }));
     }
 
     /// Whether the tile holding pixel `(x, y)` is stale.

@@ -41,13 +41,12 @@ pub trait Shader {
     /// Colour of a fragment.
     fn fragment(&self, v: &Self::Varying) -> Vec3;
 
-    /// Colours of up to 8 fragments of one triangle at once, as red, green and blue
-    /// lanes: lane `k` (for each set bit of `mask`) has weights `w[..][k]` for the
+    /// Colours of up to 8 fragments of one triangle at once: lane `k` (for each set bit of `mask`) has weights `w[..][k]` for the
     /// triangle's varyings in relative form `rel` (see [`Varying::relative`]). The
     /// default interpolates and shades lane by lane; shaders override it with 8-lane
     /// code that must give the same bits as [`Shader::fragment`] (the probe relies on it).
     #[inline(always)]
-    fn fragment8<F: F32s>(&self, rel: &[Self::Varying; 3], w: &[F; 3], mask: u8) -> [F; 3] {
+    fn fragment8<F: F32s>(&self, rel: &[Self::Varying; 3], w: &[F; 3], mask: u8) -> Shade8<F> {
         let w = each3!(|i| w[i].to_array());
         let mut out = [[0f32; 8]; 3];
         let mut m = mask;
@@ -58,8 +57,19 @@ pub trait Shader {
             (out[0][k], out[1][k], out[2][k]) = (c.x, c.y, c.z);
             m &= m - 1;
         }
-        each3!(|i| F::from_array(out[i]))
+        Shade8::Rgb(each3!(|i| F::from_array(out[i])))
     }
+}
+
+/// The colours of 8 fragments from [`Shader::fragment8`].
+#[derive(Clone, Copy, Debug)]
+pub enum Shade8<F> {
+    /// Red, green and blue lanes.
+    Rgb([F; 3]),
+    /// One value for all three channels: a grey shader says so, and the target
+    /// converts one channel instead of three (the stored bits are the same as for
+    /// `Rgb([g, g, g])`).
+    Grey(F),
 }
 
 /// Which faces to skip.
@@ -708,8 +718,10 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
             }
             mode => span_weights8(t, mode.span().unwrap_or(8), x0, y),
         };
-        let colors = self.shader.fragment8(&t.rel, &w, pass);
-        self.color.put8(start, pass, &colors);
+        match self.shader.fragment8(&t.rel, &w, pass) {
+            Shade8::Rgb(c) => self.color.put8(start, pass, &c),
+            Shade8::Grey(g) => self.color.put8_grey(start, pass, g),
+        }
         self.shaded += u64::from(pass.count_ones());
     }
 }

@@ -2,7 +2,7 @@
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
-use super::Shader;
+use super::{Shade8, Shader};
 use crate::mesh::Mesh;
 use crate::simd::{F32s, each3};
 
@@ -68,7 +68,7 @@ impl Shader for Lambert<'_> {
     }
 
     #[inline(always)]
-    fn fragment8<F: F32s>(&self, rel: &[Vec3; 3], w: &[F; 3], _mask: u8) -> [F; 3] {
+    fn fragment8<F: F32s>(&self, rel: &[Vec3; 3], w: &[F; 3], _mask: u8) -> Shade8<F> {
         // `Varying::from_relative` lane by lane: a + (b − a)·w1 + (c − a)·w2, fused.
         let [a, ba, ca] = rel;
         let [x, y, z] = each3!(
@@ -84,7 +84,14 @@ impl Shader for Lambert<'_> {
         // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
         let l = l.max(F::splat(0.0));
         let k = l.mul_add(F::splat(1.0 - self.ambient), F::splat(self.ambient));
-        each3!(|i| F::splat(self.base[i]) * k)
+        let b = self.base;
+        // A grey base (the standard scene's white) gives three equal channels: one
+        // product and, in the target, one conversion.
+        if b.x == b.y && b.y == b.z {
+            Shade8::Grey(F::splat(b.x) * k)
+        } else {
+            Shade8::Rgb(each3!(|i| F::splat(b[i]) * k))
+        }
     }
 }
 

@@ -24,6 +24,12 @@ pub trait ColorTarget {
             m &= m - 1;
         }
     }
+
+    /// [`ColorTarget::put8`] of a grey colour: `g` in all three channels.
+    #[inline(always)]
+    fn put8_grey<F: F32s>(&mut self, start: usize, mask: u8, g: F) {
+        self.put8(start, mask, &[g, g, g]);
+    }
 }
 
 /// 8-bit RGBA. Alpha records coverage: the background is cleared with alpha 0 and
@@ -60,6 +66,16 @@ impl ColorTarget for Rgba8 {
         // Pack to little-endian RGBA words and blend all 8 pixels in one store.
         let [r, g, b] = each3!(|i| to_u8x8(c[i]));
         let px = r | g.shl::<8>() | b.shl::<16>() | F::I::splat(0xFF << 24);
+        let dst: &mut [i32; 8] = bytemuck::cast_slice_mut(&mut self.0[start..start + 8])
+            .try_into()
+            .expect("8 pixels");
+        *dst = F::I::select(F::I::from_bits(mask), px, F::I::from_array(*dst)).to_array();
+    }
+    #[inline(always)]
+    fn put8_grey<F: F32s>(&mut self, start: usize, mask: u8, g: F) {
+        // One conversion; the byte is copied to red, green and blue by one multiply.
+        let v = to_u8x8(g);
+        let px = (v * F::I::splat(0x01_01_01)) | F::I::splat(0xFF << 24);
         let dst: &mut [i32; 8] = bytemuck::cast_slice_mut(&mut self.0[start..start + 8])
             .try_into()
             .expect("8 pixels");
@@ -106,8 +122,75 @@ impl<A: ColorTarget, B: ColorTarget> ColorTarget for (A, B) {
         self.0.put8(start, mask, c);
         self.1.put8(start, mask, c);
     }
+    #[inline(always)]
+    fn put8_grey<F: F32s>(&mut self, start: usize, mask: u8, g: F) {
+        self.0.put8_grey(start, mask, g);
+        self.1.put8_grey(start, mask, g);
+    }
     fn reset(&mut self, len: usize, c: Vec3) {
         self.0.reset(len, c);
         self.1.reset(len, c);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use proptest::prelude::*;
+    use wide::f32x8;
+
+    use super::{ColorTarget, Luma, Rgba8};
+    use crate::simd::F32s;
+
+    /// The 8-lane stores write exactly what `put` writes, lane by lane, and leave
+    /// unmasked pixels alone; the grey store equals the colour store of `[g, g, g]`.
+    fn check<C: ColorTarget + Clone>(
+        empty: C,
+        bits: impl Fn(&C) -> Vec<u32>,
+        rgb: [[f32; 8]; 3],
+        mask: u8,
+    ) -> Result<(), TestCaseError> {
+        let lanes = rgb.map(f32x8::from_array);
+        let mut reference = empty.clone();
+        reference.reset(10, Vec3::new(0.25, 0.5, 0.75));
+        let (mut colour, mut grey, mut grey_ref) =
+            (reference.clone(), reference.clone(), reference.clone());
+        for (k, &red) in rgb[0].iter().enumerate() {
+            if mask >> k & 1 == 1 {
+                reference.put(1 + k, Vec3::new(red, rgb[1][k], rgb[2][k]));
+                grey_ref.put(1 + k, Vec3::splat(red));
+            }
+        }
+        colour.put8(1, mask, &lanes);
+        grey.put8_grey(1, mask, lanes[0]);
+        prop_assert_eq!(bits(&colour), bits(&reference));
+        prop_assert_eq!(bits(&grey), bits(&grey_ref));
+        Ok(())
+    }
+
+    fn channel() -> impl Strategy<Value = f32> {
+        prop_oneof![
+            -0.5f32..1.5,
+            Just(f32::NAN),
+            Just(0.5 / 255.0),
+            Just(1.0),
+            Just(0.0)
+        ]
+    }
+
+    proptest! {
+        #[test]
+        fn eight_lane_stores_equal_per_pixel_stores(
+            rgb in prop::array::uniform3(prop::array::uniform8(channel())),
+            mask in any::<u8>(),
+        ) {
+            // Bit patterns, so NaN luminance compares equal to itself.
+            let rgba = |c: &Rgba8| c.0.iter().map(|p| u32::from_le_bytes(*p)).collect();
+            let luma = |c: &Luma| c.0.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            check(Rgba8::default(), rgba, rgb, mask)?;
+            check(Luma::default(), luma, rgb, mask)?;
+            let both = |c: &(Rgba8, Luma)| [rgba(&c.0), luma(&c.1)].concat();
+            check((Rgba8::default(), Luma::default()), both, rgb, mask)?;
+        }
     }
 }

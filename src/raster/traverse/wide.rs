@@ -128,23 +128,32 @@ pub fn wide_lanes<L: I32s, S: CoverageSink>(s: &Setup, sink: &mut S) {
 /// The pixels of one row that can pass all three edges: a conservative range (at
 /// least one pixel of slack on each side of the real-valued crossings), so skipping
 /// the rest is exact; the lanes still test every pixel inside it. `None` when the row
-/// is empty. Truncation with two pixels of slack stands in for floor/ceil, which are
-/// library calls on baseline x86-64.
+/// is empty. `inv[e]` is `1/sx[e]` (see [`reciprocals`]): a multiply per edge and row
+/// instead of a division, whose latency every row start would wait for. Its relative
+/// error of a few ulp moves a crossing by far less than a pixel within any box, and
+/// truncation with two pixels of slack stands in for floor/ceil (library calls on
+/// baseline x86-64).
 #[inline(always)]
-fn row_range(f: [i64; 3], sx: [i64; 3], x0: u32, x1: u32) -> Option<(u32, u32)> {
+fn row_range(f: [i64; 3], sx: [i64; 3], inv: [f64; 3], x0: u32, x1: u32) -> Option<(u32, u32)> {
     let (mut lo, mut hi) = (i64::from(x0), i64::from(x1));
     for e in 0..3 {
-        let (fe, se) = (f[e] as f64, sx[e] as f64);
+        // The crossing F(x) = f + (x − x0)·sx = 0 lies at x0 − f/sx.
+        let cross = -(f[e] as f64) * inv[e];
         if sx[e] > 0 {
-            // F(x) = f + (x − x0)·sx ≥ 0  ⇔  x ≥ x0 − f/sx
-            lo = lo.max(i64::from(x0) + (-fe / se) as i64 - 2);
+            lo = lo.max(i64::from(x0) + cross as i64 - 2);
         } else if sx[e] < 0 {
-            hi = hi.min(i64::from(x0) + (fe / -se) as i64 + 2);
+            hi = hi.min(i64::from(x0) + cross as i64 + 2);
         } else if f[e] < 0 {
             return None;
         }
     }
     (lo <= hi).then_some((lo as u32, hi as u32))
+}
+
+/// `1/sx` per edge, 0 for horizontal edges (which [`row_range`] decides by sign).
+#[inline(always)]
+fn reciprocals(sx: [i64; 3]) -> [f64; 3] {
+    each3!(|e| if sx[e] == 0 { 0.0 } else { 1.0 / sx[e] as f64 })
 }
 
 #[inline(always)]
@@ -156,11 +165,12 @@ fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
         return;
     }
     let (mut row, sx, sy) = reduced(s);
+    let inv = reciprocals(sx);
     let step8 = each3!(|e| L::splat(sx[e] * 8));
     // Lane offsets `i·sx`, built once per triangle; a row start is one splat and add.
     let ramp = each3!(|e| L::ramp(0, sx[e]));
     for y in b.y0..=b.y1 {
-        if let Some((lo, hi)) = row_range(row, sx, b.x0, b.x1) {
+        if let Some((lo, hi)) = row_range(row, sx, inv, b.x0, b.x1) {
             // Groups are aligned to multiples of 8 in the target, so a sink can store
             // a group's mask as one byte. Lanes left of the box are masked off.
             let x = lo & !7;

@@ -619,7 +619,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> CoverageSink
         self.shaded += 1;
     }
 
-    /// Eight aligned pixels from a traversal without lanes (or with `i64` lanes): the
+    /// Eight pixels from a traversal without lanes (or with `i64` lanes): the
     /// reduced edge values are formed here, then shaded as in [`CoverageSink::edges8`].
     #[inline(always)]
     fn mask8(&mut self, y: u32, x0: u32, mask: u8) {
@@ -636,7 +636,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> CoverageSink
         self.shade8(y, x0, mask, g);
     }
 
-    /// Eight aligned pixels with the `wide` traversal's `i32x8` edge lanes: one
+    /// Eight pixels with the `wide` traversal's `i32x8` edge lanes: one
     /// conversion per edge gives the exact edge values.
     #[inline(always)]
     fn edges8<G: I32s>(&mut self, y: u32, x0: u32, mask: u8, g: &[G; 3]) {
@@ -665,7 +665,8 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
         }
     }
 
-    /// The last group of a row whose width is not a multiple of 8, pixel by pixel.
+    /// A group that reaches past the target (only in targets under 8 pixels wide, see
+    /// [`CoverageSink::mask8`]), pixel by pixel.
     #[inline(never)]
     fn pixels(&mut self, y: u32, x0: u32, mask: u8) {
         let mut m = mask;
@@ -764,8 +765,8 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> EmitPiece<S::Varying>
     fn piece(&mut self, tri: &Prepared<S::Varying>) {
         let (depth_state, _) = Fragments::<S, C, L, STD>::state_of(&self.opts);
         if depth_state.uses_buffer() {
-            // Aligned groups overhang the box by at most 7 pixels, never into another
-            // tile (tiles are 16 wide and aligned).
+            // Groups can overhang the box into stale tiles, but only with lanes outside
+            // the mask, whose depth the test writes back unchanged.
             let b = tri.setup.bbox;
             self.depth.make_real(b.x0, b.y0, b.x1, b.y1);
         }

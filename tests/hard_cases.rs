@@ -16,7 +16,9 @@ use termrast::accuracy::cases;
 use termrast::accuracy::depth::{DepthFormat, DepthPass};
 use termrast::accuracy::edge::EdgeArith;
 use termrast::camera::Camera;
-use termrast::raster::clip::{ClipOutcome, classify_codes, guard_band_ndc, outcode};
+use termrast::raster::clip::{
+    ClipOutcome, ClipVertex, MAX_CLIPPED, classify_codes, clip_straddling, guard_band_ndc, outcode,
+};
 use termrast::raster::depth::{DepthFunc, DepthState};
 use termrast::raster::interp::Interpolation;
 use termrast::raster::line::{Line, NoTrace};
@@ -24,7 +26,7 @@ use termrast::raster::probe::probe;
 use termrast::raster::traverse::seed_simd_lanes;
 use termrast::raster::{CountGrid, Reject, Setup, Target, Traversal};
 use termrast::render::{
-    ColorTarget, Cull, DrawOptions, Prepared, Renderer, VertexCache, prepare, transform,
+    ColorTarget, Cull, DrawOptions, Prepared, Renderer, Rgba8, VertexCache, prepare, transform,
 };
 
 const T: Target = Target {
@@ -348,6 +350,43 @@ fn hostile_inputs_are_rejected_cleanly() {
         Setup::new([[-5.0, -5.0], [-1.0, -5.0], [-5.0, -1.0]], T),
         Err(Reject::Offscreen)
     );
+}
+
+/// Pass: a triangle whose clipped polygon rounding makes slightly non-convex (w of
+/// 1e34 beside w of 1: the guard-band planes then cut it more than twice) is dropped
+/// instead of outgrowing the polygon's nine vertices; it used to index past them.
+#[test]
+fn clipping_a_polygon_rounding_made_non_convex_does_not_overflow() {
+    let target = Target::new(24, 16);
+    let guard = guard_band_ndc(target.width, target.height);
+    let pos = [
+        Vec4::new(0.0, -0.0, 33_554_432.0, 1.038_459_4e34),
+        Vec4::new(1.0, -0.333_893, 1.640_763_4, 0.0),
+        Vec4::new(2.569_394, 1.0, -1.214_852_7, 0.166_220_95),
+    ];
+    let tri = pos.map(|pos| ClipVertex { pos, var: () });
+    if let Some(poly) = clip_straddling(tri, guard) {
+        assert!(poly.vertices().len() <= MAX_CLIPPED);
+        assert!(poly.vertices().iter().all(|v| v.pos.w > 0.0));
+    }
+    // And through the whole pipeline, both windings, every traversal.
+    for traversal in Traversal::ALL {
+        let shader = Direct {
+            attr: vec![Vec3::X, Vec3::Y, Vec3::Z],
+            clip: pos.to_vec(),
+        };
+        let opts = DrawOptions {
+            traversal,
+            ..DrawOptions::default()
+        };
+        let mut r = Renderer::new(target);
+        let mut color = Rgba8::default();
+        let mut cache = VertexCache::default();
+        r.begin_frame(target, &mut color, Vec3::ZERO);
+        transform(&shader, 3, &mut cache);
+        r.draw(&shader, &cache, &[0, 1, 2, 2, 1, 0], &opts, &mut color);
+        assert!(r.depth.to_vec().iter().all(|d| (0.0..=1.0).contains(d)));
+    }
 }
 
 /// Pass: triangles smaller than one subpixel step are exact (usually empty; a

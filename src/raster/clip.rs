@@ -11,7 +11,8 @@ use glam::Vec4;
 
 use super::interp::Varying;
 
-/// The most vertices a triangle can have after six planes.
+/// The most vertices a triangle can have after six planes (each plane adds at most
+/// one to a convex polygon).
 pub const MAX_CLIPPED: usize = 9;
 
 /// A clip-space vertex with its varyings.
@@ -147,7 +148,10 @@ pub fn clip_triangle<V: Varying>(
 }
 
 /// Clips a triangle that [`classify`] found `Clipped` (it crosses a plane and no
-/// plane rejects it); `None` when nothing with w > 0 is left.
+/// plane rejects it); `None` when nothing with w > 0 is left, or when rounding made
+/// the polygon so far from convex that a plane cut it more than twice (it would
+/// outgrow [`MAX_CLIPPED`]; only extreme coordinates do this, e.g. w near 1e34 beside
+/// w near 1, and such a triangle is dropped).
 pub fn clip_straddling<V: Varying>(tri: [ClipVertex<V>; 3], guard: [f32; 2]) -> Option<Polygon<V>> {
     let mut poly = Polygon::of(tri);
     for plane in 0..6 {
@@ -162,11 +166,11 @@ pub fn clip_straddling<V: Varying>(tri: [ClipVertex<V>; 3], guard: [f32; 2]) -> 
             let da = distances(a.pos, guard)[plane];
             let db = distances(b.pos, guard)[plane];
             if da >= 0.0 {
-                out.verts[out.len] = a;
+                *out.verts.get_mut(out.len)? = a;
                 out.len += 1;
             }
             if (da >= 0.0) != (db >= 0.0) {
-                out.verts[out.len] = intersect(a, b, da, db, plane, guard);
+                *out.verts.get_mut(out.len)? = intersect(a, b, da, db, plane, guard);
                 out.len += 1;
             }
         }

@@ -21,8 +21,9 @@ pub trait CoverageSink {
         }
     }
 
-    /// Pixel `x0 + i` of row `y` is covered for every set bit `i` of `mask`; `x0` is a
-    /// multiple of 8.
+    /// Pixel `x0 + i` of row `y` is covered for every set bit `i` of `mask`. Groups
+    /// start anywhere; all 8 of `x0..x0 + 8` lie in the target whenever it is at least
+    /// 8 pixels wide.
     #[inline]
     fn mask8(&mut self, y: u32, x0: u32, mask: u8) {
         let mut m = mask;
@@ -134,7 +135,7 @@ impl CoverageSink for Vec<(u32, u32)> {
 }
 
 /// One bit per pixel: the cheapest complete record of coverage (1080p fits in 260 KB).
-/// Bit `x % 8` of byte `x / 8` of a row; an aligned 8-pixel mask is one byte.
+/// Bit `x % 8` of byte `x / 8` of a row.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BitMask {
     pub width: u32,
@@ -194,6 +195,36 @@ impl CoverageSink for BitMask {
 
     #[inline]
     fn mask8(&mut self, y: u32, x0: u32, mask: u8) {
-        self.bits[y as usize * self.bytes_per_row + x0 as usize / 8] |= mask;
+        // A group starting at bit `b` of a byte spans that byte and the next.
+        let (i, b) = (y as usize * self.bytes_per_row + x0 as usize / 8, x0 % 8);
+        let bits = u16::from(mask) << b;
+        self.bits[i] |= bits as u8;
+        if bits > 0xFF {
+            self.bits[i + 1] |= (bits >> 8) as u8;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{BitMask, CoverageSink};
+
+    /// A group's mask lands on the same bits as its pixels one by one, wherever the
+    /// group starts (the `wide` traversal places groups on runs, not on bytes).
+    #[test]
+    fn bit_mask_groups_start_anywhere() {
+        let (w, h) = (21, 2);
+        for x0 in 0..=w - 8 {
+            for mask in 0..=255u8 {
+                let (mut group, mut pixels) = (BitMask::new(w, h), BitMask::new(w, h));
+                group.mask8(1, x0, mask);
+                for k in 0..8 {
+                    if mask >> k & 1 == 1 {
+                        pixels.pixel(x0 + k, 1);
+                    }
+                }
+                assert_eq!(group, pixels, "x0 {x0}, mask {mask:#010b}");
+            }
+        }
     }
 }

@@ -86,8 +86,8 @@ fn reduced(s: &Setup) -> ([i64; 3], [i64; 3], [i64; 3]) {
 }
 
 /// Whether every value the `wide` traversal forms for this setup fits in `i32`: the
-/// reduced edge values over the bounding box widened by the 7 pixels an aligned group
-/// can overhang on either side, plus the group step `8·I`. The bound is the triangle
+/// reduced edge values over the bounding box widened by the 7 pixels a group can
+/// overhang on either side, plus the group step `8·I`. The bound is the triangle
 /// inequality from the box origin (`|G0| + |I|·(w + 14) + |J|·h`): a few operations,
 /// conservative, and cheap because tiny triangles pay it as often as they cover pixels.
 #[must_use]
@@ -105,10 +105,11 @@ pub fn fits_i32(s: &Setup) -> bool {
 }
 
 /// Pixel-parallel traversal: 8 pixels per step, the fast path, on the reduced edge
-/// values `⌊F/256⌋` (see `reduced`). Row starts are stepped exactly in `i64`; each row is walked only over the range its edges allow
-/// (slivers and large triangles skip the empty part of their box), and within it the
-/// lanes step by `8·I` in `i32x8` when the box allows it (almost always), else in two
-/// `i64x4`.
+/// values `⌊F/256⌋` (see `reduced`). Row starts are stepped exactly in `i64`; each row
+/// is walked only over the range its edges allow (slivers and large triangles skip the
+/// empty part of their box), in groups placed on that range rather than on multiples
+/// of 8 (see `walk_run`), and the lanes step by `8·I` in `i32x8` when the box allows it
+/// (almost always), else in two `i64x4`.
 #[inline(always)]
 pub fn wide<S: CoverageSink>(s: &Setup, sink: &mut S) {
     wide_lanes::<i32x8, S>(s, sink);
@@ -167,17 +168,12 @@ fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
     let (mut row, sx, sy) = reduced(s);
     let inv = reciprocals(sx);
     let step8 = each3!(|e| L::splat(sx[e] * 8));
-    // Lane offsets `i·sx`, built once per triangle; a row start is one splat and add.
+    // Lane offsets `i·sx`, built once per triangle; a group start is one splat and add.
     let ramp = each3!(|e| L::ramp(0, sx[e]));
     for y in b.y0..=b.y1 {
         if let Some((lo, hi)) = row_range(row, sx, inv, b.x0, b.x1) {
-            // Groups are aligned to multiples of 8 in the target, so a sink can store
-            // a group's mask as one byte. Lanes left of the box are masked off.
-            let x = lo & !7;
-            let skip = i64::from(x) - i64::from(b.x0);
-            let f = each3!(|e| L::splat(row[e] + skip * sx[e]).add(ramp[e]));
-            let first = !0u8 << b.x0.saturating_sub(x).min(7);
-            walk_row(sink, y, x, hi, first, f, &step8);
+            let at = GroupLanes { row, sx, x0: b.x0 };
+            walk_run(sink, y, lo, hi, &at, &ramp, &step8);
         }
         for e in 0..3 {
             row[e] += sy[e];
@@ -186,54 +182,115 @@ fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
 }
 
 /// [`walk`] for boxes at most 16 pixels wide (most triangles of a dense mesh): every
-/// row covers the same groups, so the lanes of a row start are the previous row's
-/// plus `J`, and only the box's columns are masked.
+/// row has the same one or two groups (see [`walk_run`]), so their lanes are the
+/// previous row's plus `J` and their masks are fixed per triangle.
 #[inline(always)]
 fn walk_narrow<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
     let b = s.bbox;
     let (row, sx, sy) = reduced(s);
-    let step8 = each3!(|e| L::splat(sx[e] * 8));
     let step_y = each3!(|e| L::splat(sy[e]));
-    let x = b.x0 & !7;
-    let skip = i64::from(x) - i64::from(b.x0);
-    let mut f = each3!(|e| L::ramp(row[e] + skip * sx[e], sx[e]));
-    let first = !0u8 << (b.x0 - x);
+    let ramp = each3!(|e| L::ramp(0, sx[e]));
+    let at = GroupLanes { row, sx, x0: b.x0 };
+    // One group, or one from x0 and one ending at x1 without the lanes the first had.
+    let (n, x, mask) = if b.x1 - b.x0 < 8 {
+        let x = first_group(b.x0, b.x1);
+        (1, [x, x], [lanes(b.x0 - x, b.x1 - x), 0])
+    } else {
+        let xb = b.x1 - 7;
+        (2, [b.x0, xb], [!0, !0u8 << (b.x0 + 8 - xb)])
+    };
+    let mut f = [at.at(x[0], &ramp), at.at(x[1], &ramp)];
     for y in b.y0..=b.y1 {
-        walk_row(sink, y, x, b.x1, first, f, &step8);
-        for e in 0..3 {
-            f[e] = f[e].add(step_y[e]);
+        // One call site: the sink's fragment code is inlined once per traversal.
+        for g in 0..n {
+            group(sink, y, x[g], mask[g], &f[g]);
+            for e in 0..3 {
+                f[g][e] = f[g][e].add(step_y[e]);
+            }
         }
     }
 }
 
-/// The groups of one row from the aligned `x` to pixel `hi`: `f` holds the lanes of
-/// the first group, `first` masks the lanes of that group left of the range.
+/// The lanes of a group starting anywhere in a row: `row` holds the reduced edge
+/// values at the box's first column `x0`. A struct with a method rather than a
+/// closure: closures are compiled on their own, without the AVX2 draw loop's target
+/// features, and stay out of line.
+struct GroupLanes {
+    row: [i64; 3],
+    sx: [i64; 3],
+    x0: u32,
+}
+
+impl GroupLanes {
+    /// Lanes of the group starting at pixel `x`; `ramp` holds `i·sx` in lane `i`.
+    #[inline(always)]
+    fn at<L: Lanes>(&self, x: u32, ramp: &[L; 3]) -> [L; 3] {
+        let skip = i64::from(x) - i64::from(self.x0);
+        each3!(|e| L::splat(self.row[e] + skip * self.sx[e]).add(ramp[e]))
+    }
+}
+
+/// Where the one group of a run `lo..=hi` of at most 8 pixels starts: at `hi − 7`, so
+/// its lanes lie in the target whenever the target is 8 pixels wide (the run lies in
+/// it), or at 0 when the run ends before pixel 7.
 #[inline(always)]
-fn walk_row<L: Lanes, S: CoverageSink>(
+fn first_group(lo: u32, hi: u32) -> u32 {
+    lo.min(hi.saturating_sub(7))
+}
+
+/// Lanes `a..=b` of a group (`a ≤ b ≤ 7`).
+#[inline(always)]
+fn lanes(a: u32, b: u32) -> u8 {
+    (!0u8 >> (7 - b)) & (!0u8 << a)
+}
+
+/// One group at `x` with lanes `f`, limited to the lanes of `mask`.
+#[inline(always)]
+fn group<L: Lanes, S: CoverageSink>(sink: &mut S, y: u32, x: u32, mask: u8, f: &[L; 3]) {
+    let m = L::inside_mask(f[0], f[1], f[2]) & mask;
+    if m != 0 {
+        L::emit(sink, y, x, m, f);
+    }
+}
+
+/// The groups of the run `lo..=hi` of row `y`, whose lanes `at` gives. Groups start at the run, not at multiples of 8: 8-pixel groups
+/// from `lo`, and the last one moved left to end at `hi` with the lanes already
+/// visited masked off, so a run of `n` pixels takes `⌈n/8⌉` groups and no group
+/// reaches past the run (a run shorter than 8 is one group, see [`first_group`]).
+#[inline(always)]
+fn walk_run<L: Lanes, S: CoverageSink>(
     sink: &mut S,
     y: u32,
-    mut x: u32,
+    lo: u32,
     hi: u32,
-    mut first: u8,
-    mut f: [L; 3],
+    at: &GroupLanes,
+    ramp: &[L; 3],
     step8: &[L; 3],
 ) {
+    let (mut x, mut mask) = if hi - lo < 8 {
+        let x = first_group(lo, hi);
+        (x, lanes(lo - x, hi - x))
+    } else {
+        (lo, !0)
+    };
+    let mut f = at.at(x, ramp);
     loop {
-        let mut m = L::inside_mask(f[0], f[1], f[2]) & first;
-        first = !0;
-        let left = hi - x;
-        if left < 7 {
-            m &= (1u8 << (left + 1)) - 1;
+        // One call site: the sink's fragment code is inlined once per traversal.
+        group(sink, y, x, mask, &f);
+        if x + 7 >= hi {
+            return;
         }
-        if m != 0 {
-            L::emit(sink, y, x, m, &f);
-        }
-        if left < 8 {
-            break;
-        }
-        x += 8;
-        for e in 0..3 {
-            f[e] = f[e].add(step8[e]);
+        let next = x + 8;
+        if next + 7 <= hi {
+            x = next;
+            for e in 0..3 {
+                f[e] = f[e].add(step8[e]);
+            }
+        } else {
+            // 1 to 7 pixels are left: a group ending at `hi`, without the lanes done.
+            x = hi - 7;
+            mask = !0u8 << (next - x);
+            f = at.at(x, ramp);
         }
     }
 }

@@ -152,7 +152,6 @@ pub struct Prepared<V> {
     pub z: [f32; 3],
     /// 1/w of each vertex.
     pub inv_w: [f32; 3],
-    pub var: [V; 3],
     /// The varyings in relative form (see [`Varying::relative`]).
     pub rel: [V; 3],
     /// `1 / area2`, rounded once to f32: barycentrics are `F · inv_area2`.
@@ -571,7 +570,6 @@ fn setup_piece<V: Varying>(
         zc,
         pc: each3!(|i| (f64::from(inv_w[i]) * ia) as f32),
         rel: V::relative(&var[0], &var[1], &var[2]),
-        var,
         inv_area2: ia as f32,
         edge_rem,
     })

@@ -158,7 +158,9 @@ impl Setup {
         Self::from_fixed(v, target)
     }
 
-    /// Sets up a triangle whose vertices are already on the subpixel grid.
+    /// Sets up a triangle whose vertices are already on the subpixel grid. Inlined so
+    /// the renderer builds the setup in place in its per-triangle record.
+    #[inline(always)]
     pub fn from_fixed(mut v: [[i64; 2]; 3], target: Target) -> Result<Self, Reject> {
         let limit = (GUARD_BAND_PX as i64) * SUBPIXEL_ONE;
         let far = |p: [i64; 2]| p[0].abs() > limit || p[1].abs() > limit;

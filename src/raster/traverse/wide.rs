@@ -230,9 +230,9 @@ impl GroupLanes {
     }
 }
 
-/// Where the one group of a run `lo..=hi` of at most 8 pixels starts: at `hi − 7`, so
-/// its lanes lie in the target whenever the target is 8 pixels wide (the run lies in
-/// it), or at 0 when the run ends before pixel 7.
+/// Where the one group of a run `lo..=hi` of at most 8 pixels starts: at `hi − 7`
+/// (never right of `lo`), so its lanes lie in the target whenever the target is at
+/// least 8 pixels wide (the run lies in it), or at 0 when the run ends before pixel 7.
 #[inline(always)]
 fn first_group(lo: u32, hi: u32) -> u32 {
     lo.min(hi.saturating_sub(7))
@@ -253,10 +253,11 @@ fn group<L: Lanes, S: CoverageSink>(sink: &mut S, y: u32, x: u32, mask: u8, f: &
     }
 }
 
-/// The groups of the run `lo..=hi` of row `y`, whose lanes `at` gives. Groups start at the run, not at multiples of 8: 8-pixel groups
-/// from `lo`, and the last one moved left to end at `hi` with the lanes already
-/// visited masked off, so a run of `n` pixels takes `⌈n/8⌉` groups and no group
-/// reaches past the run (a run shorter than 8 is one group, see [`first_group`]).
+/// The groups of the run `lo..=hi` of row `y`, whose lanes `at` gives. Groups start
+/// at the run, not at multiples of 8: 8-pixel groups from `lo`, and the last one
+/// moved left to end at `hi` with the lanes already visited masked off, so a run of
+/// `n` pixels takes `⌈n/8⌉` groups and no group reaches past the run (a run of at
+/// most 8 pixels is one group, see [`first_group`]).
 #[inline(always)]
 fn walk_run<L: Lanes, S: CoverageSink>(
     sink: &mut S,

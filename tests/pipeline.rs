@@ -303,6 +303,53 @@ fn traversals_and_instruction_sets_draw_identical_frames() {
     }
 }
 
+/// Targets narrower than a group (and just wider): `wide` then has groups that reach
+/// past the right edge or start left of a box, and the fragment stage falls back to
+/// single pixels; every traversal on both instruction sets still draws the scalar
+/// reference's frame.
+#[test]
+fn narrow_targets_draw_the_same_frame_with_every_traversal() {
+    let model = Model::new(bunny());
+    for (w, h) in [(1, 1), (3, 5), (7, 6), (8, 4), (9, 9), (15, 12), (17, 10)] {
+        let target = Target::new(w, h);
+        let frame_of = |traversal: Traversal, isa: Isa| {
+            let opts = DrawOptions {
+                traversal,
+                ..DrawOptions::default()
+            };
+            let mut frame = StandardFrame::new(target);
+            frame.renderer.isa = isa;
+            let mut color = Rgba8::default();
+            // Close up, so the model reaches past every side of the target.
+            let mut view = StandardView::at(0.4);
+            view.camera.eye = Vec3::new(0.0, 0.0, 1.3);
+            frame.draw(&model, &view, target, &opts, Mode::Fill, &mut color);
+            let depth: Vec<u32> = frame
+                .renderer
+                .depth
+                .to_vec()
+                .iter()
+                .map(|d| d.to_bits())
+                .collect();
+            (color.0, depth)
+        };
+        let reference = frame_of(Traversal::Scalar, Isa::Baseline);
+        assert!(
+            reference.0.iter().any(|p| p[3] == 255),
+            "{w}x{h} draws something"
+        );
+        for traversal in Traversal::ALL {
+            for isa in [Isa::Baseline, Isa::detect()] {
+                assert!(
+                    frame_of(traversal, isa) == reference,
+                    "{} on {isa:?} at {w}x{h} differs from scalar",
+                    traversal.name()
+                );
+            }
+        }
+    }
+}
+
 /// A triangle far larger than the target takes `wide`'s `i64` fallback (its edge
 /// values do not fit `i32` lanes); it still equals the scalar traversal and the probe.
 #[test]

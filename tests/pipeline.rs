@@ -254,6 +254,28 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
     }
 }
 
+/// The colour and depth bits of one standard-scene frame.
+fn frame_bits(
+    model: &Model,
+    target: Target,
+    view: &StandardView,
+    opts: &DrawOptions,
+    isa: Isa,
+) -> (Vec<[u8; 4]>, Vec<u32>) {
+    let mut frame = StandardFrame::new(target);
+    frame.renderer.isa = isa;
+    let mut color = Rgba8::default();
+    frame.draw(model, view, target, opts, Mode::Fill, &mut color);
+    let depth = frame
+        .renderer
+        .depth
+        .to_vec()
+        .iter()
+        .map(|d| d.to_bits())
+        .collect();
+    (color.0, depth)
+}
+
 /// Every traversal, on both instruction sets, gives the same framebuffer bit for bit:
 /// coverage is exact, and the fragment paths (`wide`'s `i32x8` edge lanes, the `i64`
 /// fallback, the per-pixel path of the others) perform the same f32 operations.
@@ -261,40 +283,22 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
 fn traversals_and_instruction_sets_draw_identical_frames() {
     let model = Model::new(bunny());
     let target = Target::new(160, 120);
-    let frame_of = |traversal: Traversal, isa: Isa, interpolation: Interpolation| {
-        let opts = DrawOptions {
-            traversal,
-            interpolation,
-            ..DrawOptions::default()
-        };
-        let mut frame = StandardFrame::new(target);
-        frame.renderer.isa = isa;
-        let mut color = Rgba8::default();
-        frame.draw(
-            &model,
-            &StandardView::at(0.9),
-            target,
-            &opts,
-            Mode::Fill,
-            &mut color,
-        );
-        let depth: Vec<u32> = frame
-            .renderer
-            .depth
-            .to_vec()
-            .iter()
-            .map(|d| d.to_bits())
-            .collect();
-        (color.0, depth)
-    };
+    let view = StandardView::at(0.9);
     for interpolation in Interpolation::ALL {
-        let reference = frame_of(Traversal::Scalar, Isa::Baseline, interpolation);
+        let frame_of = |traversal: Traversal, isa: Isa| {
+            let opts = DrawOptions {
+                traversal,
+                interpolation,
+                ..DrawOptions::default()
+            };
+            frame_bits(&model, target, &view, &opts, isa)
+        };
+        let reference = frame_of(Traversal::Scalar, Isa::Baseline);
         assert!(reference.0.iter().filter(|p| p[3] == 255).count() > 3000);
         for traversal in Traversal::ALL {
             for isa in [Isa::Baseline, Isa::detect()] {
-                let got = frame_of(traversal, isa, interpolation);
                 assert!(
-                    got == reference,
+                    frame_of(traversal, isa) == reference,
                     "{} on {isa:?} ({interpolation:?}) differs from scalar",
                     traversal.name()
                 );
@@ -310,6 +314,9 @@ fn traversals_and_instruction_sets_draw_identical_frames() {
 #[test]
 fn narrow_targets_draw_the_same_frame_with_every_traversal() {
     let model = Model::new(bunny());
+    // Close up, so the model reaches past every side of the target.
+    let mut view = StandardView::at(0.4);
+    view.camera.eye = Vec3::new(0.0, 0.0, 1.3);
     for (w, h) in [(1, 1), (3, 5), (7, 6), (8, 4), (9, 9), (15, 12), (17, 10)] {
         let target = Target::new(w, h);
         let frame_of = |traversal: Traversal, isa: Isa| {
@@ -317,27 +324,11 @@ fn narrow_targets_draw_the_same_frame_with_every_traversal() {
                 traversal,
                 ..DrawOptions::default()
             };
-            let mut frame = StandardFrame::new(target);
-            frame.renderer.isa = isa;
-            let mut color = Rgba8::default();
-            // Close up, so the model reaches past every side of the target.
-            let mut view = StandardView::at(0.4);
-            view.camera.eye = Vec3::new(0.0, 0.0, 1.3);
-            frame.draw(&model, &view, target, &opts, Mode::Fill, &mut color);
-            let depth: Vec<u32> = frame
-                .renderer
-                .depth
-                .to_vec()
-                .iter()
-                .map(|d| d.to_bits())
-                .collect();
-            (color.0, depth)
+            frame_bits(&model, target, &view, &opts, isa)
         };
         let reference = frame_of(Traversal::Scalar, Isa::Baseline);
-        assert!(
-            reference.0.iter().any(|p| p[3] == 255),
-            "{w}x{h} draws something"
-        );
+        let covered = reference.0.iter().filter(|p| p[3] == 255).count();
+        assert!(covered * 2 > reference.0.len(), "{w}x{h} is mostly covered");
         for traversal in Traversal::ALL {
             for isa in [Isa::Baseline, Isa::detect()] {
                 assert!(

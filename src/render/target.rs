@@ -56,6 +56,18 @@ pub fn to_u8x8<F: F32s>(v: F) -> F::I {
     (v * F::splat(255.0) + F::splat(0.5)).trunc_i32()
 }
 
+impl Rgba8 {
+    /// Stores packed RGBA words `px` into pixels `start..start + 8` where `mask` is
+    /// set, in one blended store.
+    #[inline(always)]
+    fn blend8<I: I32s>(&mut self, start: usize, mask: u8, px: I) {
+        let dst: &mut [i32; 8] = bytemuck::cast_slice_mut(&mut self.0[start..start + 8])
+            .try_into()
+            .expect("8 pixels");
+        *dst = I::select(I::from_bits(mask), px, I::from_array(*dst)).to_array();
+    }
+}
+
 impl ColorTarget for Rgba8 {
     #[inline(always)]
     fn put(&mut self, index: usize, c: Vec3) {
@@ -66,20 +78,14 @@ impl ColorTarget for Rgba8 {
         // Pack to little-endian RGBA words and blend all 8 pixels in one store.
         let [r, g, b] = each3!(|i| to_u8x8(c[i]));
         let px = r | g.shl::<8>() | b.shl::<16>() | F::I::splat(0xFF << 24);
-        let dst: &mut [i32; 8] = bytemuck::cast_slice_mut(&mut self.0[start..start + 8])
-            .try_into()
-            .expect("8 pixels");
-        *dst = F::I::select(F::I::from_bits(mask), px, F::I::from_array(*dst)).to_array();
+        self.blend8(start, mask, px);
     }
     #[inline(always)]
     fn put8_grey<F: F32s>(&mut self, start: usize, mask: u8, g: F) {
         // One conversion; the byte is copied to red, green and blue by one multiply.
         let v = to_u8x8(g);
         let px = (v * F::I::splat(0x01_01_01)) | F::I::splat(0xFF << 24);
-        let dst: &mut [i32; 8] = bytemuck::cast_slice_mut(&mut self.0[start..start + 8])
-            .try_into()
-            .expect("8 pixels");
-        *dst = F::I::select(F::I::from_bits(mask), px, F::I::from_array(*dst)).to_array();
+        self.blend8(start, mask, px);
     }
     fn reset(&mut self, len: usize, c: Vec3) {
         let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0];

@@ -108,6 +108,25 @@ pub fn parse_size(s: &str) -> Result<Target, String> {
     Ok(Target::new(w, h))
 }
 
+/// Parses an instruction set name, refusing one the running CPU lacks (it would
+/// silently fall back to the baseline, and a benchmark would measure the wrong code).
+pub fn parse_isa(s: &str) -> Result<crate::render::Isa, String> {
+    use crate::render::Isa;
+    let names = || Isa::ALL.map(Isa::name).join(", ");
+    let isa = Isa::ALL
+        .into_iter()
+        .find(|isa| isa.name() == s)
+        .ok_or_else(|| format!("unknown instruction set `{s}`; one of {}", names()))?;
+    if !isa.is_supported() {
+        let have: Vec<_> = Isa::supported().map(Isa::name).collect();
+        return Err(format!(
+            "this CPU cannot run `{s}`; it supports {}",
+            have.join(", ")
+        ));
+    }
+    Ok(isa)
+}
+
 /// Largest target in pixels (2^25, a little over 8K): colour and depth buffers then
 /// stay within about 270 MB instead of failing to allocate.
 pub const MAX_PIXELS: u64 = 1 << 25;

@@ -785,9 +785,9 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> EmitPiece<S::Varying>
     }
 }
 
-/// Which instructions the draw loop is compiled for. Both give identical bits: only
+/// Which instructions the draw loop is compiled for. All give identical bits: only
 /// instruction selection differs (fused multiply-adds are written as such and are
-/// correctly rounded on both), nothing is reordered.
+/// correctly rounded on every one), nothing is reordered.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
     /// The build's target (baseline x86-64: 8-lane types run as two SSE halves).
@@ -796,30 +796,65 @@ pub enum Isa {
     /// the per-group fragment counts and lane loops), chosen at run time when the CPU
     /// has them.
     Avx2,
+    /// [`Isa::Avx2`]'s code on the same 256-bit lanes, compiled with AVX-512 (F, VL, BW,
+    /// DQ) enabled as well. The lanes stay 8 wide; what the compiler gains is 32 vector
+    /// registers instead of 16 (fewer per-triangle constants spilled and reloaded) and
+    /// mask registers for compares and blends.
+    Avx512,
 }
 
 impl Isa {
+    /// Every instruction set, from the most widely available.
+    pub const ALL: [Isa; 3] = [Isa::Baseline, Isa::Avx2, Isa::Avx512];
+
     /// The best the running CPU supports.
     #[must_use]
     pub fn detect() -> Self {
-        if Self::has_avx2() {
-            return Isa::Avx2;
-        }
-        Isa::Baseline
+        Self::ALL
+            .into_iter()
+            .rev()
+            .find(|isa| isa.is_supported())
+            .unwrap_or(Isa::Baseline)
     }
 
-    /// Whether the CPU has what [`Isa::Avx2`] is compiled for.
+    /// The instruction sets the running CPU supports (always including the baseline).
+    pub fn supported() -> impl Iterator<Item = Isa> {
+        Self::ALL.into_iter().filter(|isa| isa.is_supported())
+    }
+
+    /// Whether the running CPU has what this instruction set is compiled for.
     #[must_use]
-    pub fn has_avx2() -> bool {
+    pub fn is_supported(self) -> bool {
         #[cfg(target_arch = "x86_64")]
         {
-            std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("fma")
-                && std::arch::is_x86_feature_detected!("popcnt")
-                && std::arch::is_x86_feature_detected!("bmi1")
+            use std::arch::is_x86_feature_detected as has;
+            let avx2 = || has!("avx2") && has!("fma") && has!("popcnt") && has!("bmi1");
+            match self {
+                Isa::Baseline => true,
+                Isa::Avx2 => avx2(),
+                Isa::Avx512 => {
+                    avx2()
+                        && has!("avx512f")
+                        && has!("avx512vl")
+                        && has!("avx512bw")
+                        && has!("avx512dq")
+                }
+            }
         }
         #[cfg(not(target_arch = "x86_64"))]
-        false
+        {
+            self == Isa::Baseline
+        }
+    }
+
+    /// The name used on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Isa::Baseline => "baseline",
+            Isa::Avx2 => "avx2",
+            Isa::Avx512 => "avx512",
+        }
     }
 }
 
@@ -895,10 +930,18 @@ impl Renderer {
             self.depth.reset(self.target.width, self.target.height);
         }
         #[cfg(target_arch = "x86_64")]
-        if self.isa == Isa::Avx2 && Isa::has_avx2() {
-            // SAFETY: the CPU has AVX2, FMA, POPCNT and BMI1, checked just above.
-            unsafe { self.draw_avx2(shader, cache, indices, opts, color) };
-            return;
+        match self.isa {
+            Isa::Avx512 if Isa::Avx512.is_supported() => {
+                // SAFETY: the CPU has every feature `draw_avx512` enables, checked just above.
+                unsafe { self.draw_avx512(shader, cache, indices, opts, color) };
+                return;
+            }
+            Isa::Avx2 if Isa::Avx2.is_supported() => {
+                // SAFETY: the CPU has AVX2, FMA, POPCNT and BMI1, checked just above.
+                unsafe { self.draw_avx2(shader, cache, indices, opts, color) };
+                return;
+            }
+            _ => {}
         }
         self.draw_triangles::<_, _, wide::i32x8>(shader, cache, indices, opts, color);
     }
@@ -911,6 +954,21 @@ impl Renderer {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,popcnt,bmi1")]
     unsafe fn draw_avx2<S: Shader, C: ColorTarget>(
+        &mut self,
+        shader: &S,
+        cache: &VertexCache<S::Varying>,
+        indices: &[u32],
+        opts: &DrawOptions,
+        color: &mut C,
+    ) {
+        self.draw_triangles::<_, _, crate::simd::avx2::I32x8>(shader, cache, indices, opts, color);
+    }
+
+    /// [`Renderer::draw_avx2`]'s loop, on the same AVX2 lanes, with AVX-512 enabled
+    /// too (see [`Isa::Avx512`]): the same operations, so the same bits.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,avx512f,avx512vl,avx512bw,avx512dq")]
+    unsafe fn draw_avx512<S: Shader, C: ColorTarget>(
         &mut self,
         shader: &S,
         cache: &VertexCache<S::Varying>,

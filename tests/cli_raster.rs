@@ -1,7 +1,9 @@
-//! `termrast raster` end to end, through the real binary.
+//! `termrast raster`, `render`, `line` and `bench render` end to end, through the real binary.
 
 use std::io::Write;
 use std::process::{Command, Stdio};
+
+use termrast::render::Isa;
 
 fn raster(args: &[&str], stdin: &str) -> (bool, String, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_termrast"))
@@ -189,4 +191,41 @@ fn line_command_rejects_bad_input() {
     // At x = 0 the ideal y is exactly 0.5: a tie, resolved toward the start's row (0);
     // from x = 1 on it is above 0.5.
     assert_eq!(out, "0,0 1,1 2,1 3,1 4,1 5,1 6,1 7,1\n");
+}
+
+/// `bench render` runs on the instruction set it is given, reports it, and covers the
+/// same fragments on each; it refuses a name it does not know and one the CPU lacks.
+#[test]
+fn bench_render_reports_and_checks_its_instruction_set() {
+    let field = |out: &str, key: &str| {
+        out.split_whitespace()
+            .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+            .map(str::to_owned)
+            .unwrap_or_else(|| panic!("no {key} in {out}"))
+    };
+    let mut covered = Vec::new();
+    for isa in Isa::supported() {
+        let (ok, out, err) = termrast(&[
+            "bench",
+            "render",
+            "teapot",
+            "--size",
+            "96x64",
+            "--frames",
+            "2",
+            "--isa",
+            isa.name(),
+        ]);
+        assert!(ok, "{err}");
+        assert_eq!(field(&out, "isa"), isa.name());
+        covered.push(field(&out, "covered_px"));
+    }
+    assert!(covered.windows(2).all(|w| w[0] == w[1]), "{covered:?}");
+    assert_ne!(covered[0], "0");
+    let (ok, _, err) = termrast(&["bench", "render", "--frames", "1", "--isa", "sse9"]);
+    assert!(!ok && err.contains("baseline, avx2, avx512"), "{err}");
+    if let Some(missing) = Isa::ALL.into_iter().find(|isa| !isa.is_supported()) {
+        let (ok, _, err) = termrast(&["bench", "render", "--frames", "1", "--isa", missing.name()]);
+        assert!(!ok && err.contains("cannot run"), "{err}");
+    }
 }

@@ -276,7 +276,7 @@ fn frame_bits(
     (color.0, depth)
 }
 
-/// Every traversal, on both instruction sets, gives the same framebuffer bit for bit:
+/// Every traversal, on every instruction set the CPU has, gives the same framebuffer bit for bit:
 /// coverage is exact, and the fragment paths (`wide`'s `i32x8` edge lanes, the `i64`
 /// fallback, the per-pixel path of the others) perform the same f32 operations.
 #[test]
@@ -296,7 +296,7 @@ fn traversals_and_instruction_sets_draw_identical_frames() {
         let reference = frame_of(Traversal::Scalar, Isa::Baseline);
         assert!(reference.0.iter().filter(|p| p[3] == 255).count() > 3000);
         for traversal in Traversal::ALL {
-            for isa in [Isa::Baseline, Isa::detect()] {
+            for isa in Isa::supported() {
                 assert!(
                     frame_of(traversal, isa) == reference,
                     "{} on {isa:?} ({interpolation:?}) differs from scalar",
@@ -309,7 +309,7 @@ fn traversals_and_instruction_sets_draw_identical_frames() {
 
 /// Targets narrower than a group (and just wider): `wide` then has groups that reach
 /// past the right edge or start left of a box, and the fragment stage falls back to
-/// single pixels; every traversal on both instruction sets still draws the scalar
+/// single pixels; every traversal on every instruction set the CPU has still draws the scalar
 /// reference's frame.
 #[test]
 fn narrow_targets_draw_the_same_frame_with_every_traversal() {
@@ -330,7 +330,7 @@ fn narrow_targets_draw_the_same_frame_with_every_traversal() {
         let covered = reference.0.iter().filter(|p| p[3] == 255).count();
         assert!(covered * 2 > reference.0.len(), "{w}x{h} is mostly covered");
         for traversal in Traversal::ALL {
-            for isa in [Isa::Baseline, Isa::detect()] {
+            for isa in Isa::supported() {
                 assert!(
                     frame_of(traversal, isa) == reference,
                     "{} on {isa:?} at {w}x{h} differs from scalar",

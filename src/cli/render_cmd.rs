@@ -12,7 +12,7 @@ use crate::raster::interp::Interpolation;
 use crate::raster::{Target, Traversal};
 use crate::render::standard::{Model, RADIANS_PER_FRAME, StandardFrame, StandardView};
 use crate::render::wire::Mode;
-use crate::render::{Cull, DrawOptions, Rgba8};
+use crate::render::{Cull, DrawOptions, Isa, Rgba8};
 use crate::scene::render::{SceneFrame, SceneView};
 use crate::scene::{Scene, is_scene_path};
 
@@ -104,6 +104,10 @@ pub struct BenchRenderArgs {
     /// Rendering threads (the renderer is single-threaded; only 1 is accepted).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1))]
     pub threads: u32,
+    /// The draw loop's instruction set: baseline, avx2 or avx512 (default: the best
+    /// this CPU has). All give identical images.
+    #[arg(long, value_parser = super::parse_isa)]
+    pub isa: Option<Isa>,
 }
 
 /// Writes frames of the standard scene as ANSI text, or one as a PNG with `--out`.
@@ -228,6 +232,8 @@ pub struct BenchReport {
     pub triangles: usize,
     /// Covered fragments per frame (mean), overdraw included.
     pub covered_px: u64,
+    /// The draw loop's instruction set.
+    pub isa: Isa,
 }
 
 impl std::fmt::Display for BenchReport {
@@ -235,8 +241,13 @@ impl std::fmt::Display for BenchReport {
         let mpx = self.covered_px as f64 / (self.median_ms * 1e3);
         write!(
             f,
-            "median_ms={:.3} min_ms={:.3} triangles={} covered_px={} mpx_per_s={:.1}",
-            self.median_ms, self.min_ms, self.triangles, self.covered_px, mpx
+            "median_ms={:.3} min_ms={:.3} triangles={} covered_px={} mpx_per_s={:.1} isa={}",
+            self.median_ms,
+            self.min_ms,
+            self.triangles,
+            self.covered_px,
+            mpx,
+            self.isa.name()
         )
     }
 }
@@ -247,6 +258,9 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
     let target = args.size;
     let opts = args.scene.options();
     let mut frame = StandardFrame::new(target);
+    if let Some(isa) = args.isa {
+        frame.renderer.isa = isa;
+    }
     let mut color = Rgba8::default();
     let frames = args.frames.max(1);
     let mut times = Vec::with_capacity(frames as usize);
@@ -270,5 +284,6 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
         min_ms: times[0],
         triangles: model.mesh.triangle_count(),
         covered_px: covered / u64::from(frames),
+        isa: frame.renderer.isa,
     })
 }

@@ -295,6 +295,7 @@ impl Setup {
 }
 
 /// Pixels whose centres lie within the vertices' bounding box, clipped to the target.
+#[inline(always)]
 fn pixel_bounds(v: &[[i64; 2]; 3], target: Target) -> Option<PixelRect> {
     if target.is_empty() {
         return None;

@@ -129,21 +129,26 @@ pub fn wide_lanes<L: I32s, S: CoverageSink>(s: &Setup, sink: &mut S) {
 /// The pixels of one row that can pass all three edges: a conservative range (at
 /// least one pixel of slack on each side of the real-valued crossings), so skipping
 /// the rest is exact; the lanes still test every pixel inside it. `None` when the row
-/// is empty. `inv[e]` is `1/sx[e]` (see [`reciprocals`]): a multiply per edge and row
-/// instead of a division, whose latency every row start would wait for. Its relative
-/// error of a few ulp moves a crossing by far less than a pixel within any box, and
-/// truncation with two pixels of slack stands in for floor/ceil (library calls on
-/// baseline x86-64).
+/// is empty. `neg_inv[e]` is `−1/sx[e]` (see [`neg_reciprocals`]): a multiply per edge
+/// and row instead of a division, whose latency every row start would wait for. Its
+/// relative error of a few ulp moves a crossing by far less than a pixel within any
+/// box, and truncation with two pixels of slack stands in for floor/ceil (library
+/// calls on baseline x86-64).
 #[inline(always)]
-fn row_range(f: [i64; 3], sx: [i64; 3], inv: [f64; 3], x0: u32, x1: u32) -> Option<(u32, u32)> {
+fn row_range(f: [i64; 3], sx: [i64; 3], neg_inv: [f64; 3], x0: u32, x1: u32) -> Option<(u32, u32)> {
     let (mut lo, mut hi) = (i64::from(x0), i64::from(x1));
     for e in 0..3 {
         // The crossing F(x) = f + (x − x0)·sx = 0 lies at x0 − f/sx.
-        let cross = -(f[e] as f64) * inv[e];
+        let cross = f[e] as f64 * neg_inv[e];
+        // SAFETY: finite and within `i64`: `sx ≠ 0` here (else `neg_inv` is 0), and
+        // `|f| < 2^54` (an edge value in the guard band, divided by 256), so
+        // `|cross| ≤ |f|`. Unchecked because `as` would add a saturating clamp and a NaN
+        // test (five instructions) per edge and row.
+        let cross: i64 = unsafe { cross.to_int_unchecked() };
         if sx[e] > 0 {
-            lo = lo.max(i64::from(x0) + cross as i64 - 2);
+            lo = lo.max(i64::from(x0) + cross - 2);
         } else if sx[e] < 0 {
-            hi = hi.min(i64::from(x0) + cross as i64 + 2);
+            hi = hi.min(i64::from(x0) + cross + 2);
         } else if f[e] < 0 {
             return None;
         }
@@ -151,10 +156,10 @@ fn row_range(f: [i64; 3], sx: [i64; 3], inv: [f64; 3], x0: u32, x1: u32) -> Opti
     (lo <= hi).then_some((lo as u32, hi as u32))
 }
 
-/// `1/sx` per edge, 0 for horizontal edges (which [`row_range`] decides by sign).
+/// `−1/sx` per edge, 0 for horizontal edges (which [`row_range`] decides by sign).
 #[inline(always)]
-fn reciprocals(sx: [i64; 3]) -> [f64; 3] {
-    each3!(|e| if sx[e] == 0 { 0.0 } else { 1.0 / sx[e] as f64 })
+fn neg_reciprocals(sx: [i64; 3]) -> [f64; 3] {
+    each3!(|e| if sx[e] == 0 { 0.0 } else { -1.0 / sx[e] as f64 })
 }
 
 #[inline(always)]
@@ -166,14 +171,14 @@ fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
         return;
     }
     let (mut row, sx, sy) = reduced(s);
-    let inv = reciprocals(sx);
+    let neg_inv = neg_reciprocals(sx);
     let step8 = each3!(|e| L::splat(sx[e] * 8));
     // Lane offsets `i·sx`, built once per triangle; a group start is one splat and add.
     let ramp = each3!(|e| L::ramp(0, sx[e]));
     for y in b.y0..=b.y1 {
-        if let Some((lo, hi)) = row_range(row, sx, inv, b.x0, b.x1) {
+        if let Some((lo, hi)) = row_range(row, sx, neg_inv, b.x0, b.x1) {
             let at = GroupLanes { row, sx, x0: b.x0 };
-            walk_run(sink, y, lo, hi, &at, &ramp, &step8);
+            walk_run(sink, y, lo, hi, b.x1, &at, &ramp, &step8);
         }
         for e in 0..3 {
             row[e] += sy[e];
@@ -228,6 +233,13 @@ impl GroupLanes {
         let skip = i64::from(x) - i64::from(self.x0);
         each3!(|e| L::splat(self.row[e] + skip * self.sx[e]).add(ramp[e]))
     }
+
+    /// Lanes of the group starting at pixel `to`, from those `f` of the group at `from`.
+    #[inline(always)]
+    fn moved<L: Lanes>(&self, f: [L; 3], to: u32, from: u32) -> [L; 3] {
+        let d = i64::from(to) - i64::from(from);
+        each3!(|e| f[e].add(L::splat(d * self.sx[e])))
+    }
 }
 
 /// Where the one group of a run `lo..=hi` of at most 8 pixels starts: at `hi − 7`
@@ -253,45 +265,47 @@ fn group<L: Lanes, S: CoverageSink>(sink: &mut S, y: u32, x: u32, mask: u8, f: &
     }
 }
 
-/// The groups of the run `lo..=hi` of row `y`, whose lanes `at` gives. Groups start
-/// at the run, not at multiples of 8: 8-pixel groups from `lo`, and the last one
-/// moved left to end at `hi` with the lanes already visited masked off, so a run of
-/// `n` pixels takes `⌈n/8⌉` groups and no group reaches past the run (a run of at
-/// most 8 pixels is one group, see [`first_group`]).
+/// The groups of the run `lo..=hi` of row `y` in a box ending at `x1` (at least 8
+/// pixels wide), whose lanes `at` gives. Groups start at the run, not at multiples of
+/// 8: 8-pixel groups from `lo`, stepped by `8·I`, the last one with the lanes past
+/// `hi` masked off, so a run of `n` pixels takes `⌈n/8⌉` groups. A group that would
+/// reach past the box is moved left to end at `x1`, with the lanes already visited
+/// masked off: the box lies in the target, so every group does too. That needs the
+/// lanes recomputed, which only rows near the box's right side pay.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn walk_run<L: Lanes, S: CoverageSink>(
     sink: &mut S,
     y: u32,
     lo: u32,
     hi: u32,
+    x1: u32,
     at: &GroupLanes,
     ramp: &[L; 3],
     step8: &[L; 3],
 ) {
-    let (mut x, mut mask) = if hi - lo < 8 {
-        let x = first_group(lo, hi);
-        (x, lanes(lo - x, hi - x))
-    } else {
-        (lo, !0)
-    };
+    let mut x = lo;
     let mut f = at.at(x, ramp);
     loop {
+        let mask = if x + 7 <= x1 {
+            lanes(0, hi.min(x + 7) - x)
+        } else {
+            let left = x1 - 7;
+            // From `f`, not `at.at(left, ..)`: that does not depend on the group, so
+            // the compiler would compute it ahead for every row.
+            f = at.moved(f, left, x);
+            let mask = lanes(x - left, hi - left);
+            x = left;
+            mask
+        };
         // One call site: the sink's fragment code is inlined once per traversal.
         group(sink, y, x, mask, &f);
         if x + 7 >= hi {
             return;
         }
-        let next = x + 8;
-        if next + 7 <= hi {
-            x = next;
-            for e in 0..3 {
-                f[e] = f[e].add(step8[e]);
-            }
-        } else {
-            // 1 to 7 pixels are left: a group ending at `hi`, without the lanes done.
-            x = hi - 7;
-            mask = !0u8 << (next - x);
-            f = at.at(x, ramp);
+        x += 8;
+        for e in 0..3 {
+            f[e] = f[e].add(step8[e]);
         }
     }
 }

@@ -23,8 +23,14 @@ pub struct Lambert<'a> {
     pub normal_matrix: Mat3,
     /// Towards the light, normalised, world space.
     pub light: Vec3,
-    pub base: Vec3,
-    pub ambient: f32,
+    /// Surface colour, set with the ambient term by [`Lambert::with_material`], which
+    /// also derives the two values below once per draw rather than per fragment.
+    base: Vec3,
+    ambient: f32,
+    /// `1 − ambient`.
+    diffuse: f32,
+    /// Whether the three channels of `base` are equal (see [`Shade8::Grey`]).
+    grey: bool,
 }
 
 impl<'a> Lambert<'a> {
@@ -37,7 +43,22 @@ impl<'a> Lambert<'a> {
             normal_matrix: Mat3::from_mat4(model).inverse().transpose(),
             light: standard_light(),
             base: Vec3::ONE,
-            ambient: 0.08,
+            ambient: 0.0,
+            diffuse: 1.0,
+            grey: true,
+        }
+        .with_material(Vec3::ONE, 0.08)
+    }
+
+    /// The same shader with surface colour `base` and ambient term `ambient`.
+    #[must_use]
+    pub fn with_material(self, base: Vec3, ambient: f32) -> Self {
+        Self {
+            base,
+            ambient,
+            diffuse: 1.0 - ambient,
+            grey: base.x == base.y && base.y == base.z,
+            ..self
         }
     }
 }
@@ -63,7 +84,7 @@ impl Shader for Lambert<'_> {
         let d = n.z.mul_add(lt.z, n.y.mul_add(lt.y, n.x * lt.x));
         let l = d / len;
         let l = if l > 0.0 { l } else { 0.0 };
-        let k = l.mul_add(1.0 - self.ambient, self.ambient);
+        let k = l.mul_add(self.diffuse, self.ambient);
         self.base * k
     }
 
@@ -83,11 +104,11 @@ impl Shader for Lambert<'_> {
         let l = d / len;
         // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
         let l = l.max(F::splat(0.0));
-        let k = l.mul_add(F::splat(1.0 - self.ambient), F::splat(self.ambient));
+        let k = l.mul_add(F::splat(self.diffuse), F::splat(self.ambient));
         let b = self.base;
         // A grey base (the standard scene's white) gives three equal channels: one
         // product and, in the target, one conversion.
-        if b.x == b.y && b.y == b.z {
+        if self.grey {
             Shade8::Grey(F::splat(b.x) * k)
         } else {
             Shade8::Rgb(each3!(|i| F::splat(b[i]) * k))
@@ -117,5 +138,57 @@ impl<F: Fn(u32) -> Vec3> Shader for Attribute<F> {
 
     fn fragment(&self, v: &Vec3) -> Vec3 {
         *v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Mat4, Vec3};
+    use proptest::prelude::*;
+    use wide::f32x8;
+
+    use super::Lambert;
+    use crate::mesh::Mesh;
+    use crate::raster::interp::Varying;
+    use crate::render::{Shade8, Shader};
+    use crate::simd::F32s;
+
+    fn vec3() -> impl Strategy<Value = Vec3> {
+        prop::array::uniform3(-2.0f32..2.0).prop_map(Vec3::from)
+    }
+
+    proptest! {
+        /// Lambert's 8-lane fragments equal its per-pixel ones bit for bit, for grey
+        /// bases (one channel) and coloured ones (three), on every lane of the mask.
+        #[test]
+        fn lambert_lanes_equal_single_fragments(
+            verts in prop::array::uniform3(vec3()),
+            w in prop::array::uniform3(prop::array::uniform8(0.0f32..1.0)),
+            base in vec3(),
+            grey in any::<bool>(),
+            ambient in 0.0f32..0.5,
+            mask in 1..=255u8,
+        ) {
+            let mesh = Mesh::teapot();
+            let base = if grey { Vec3::splat(base.x.abs()) } else { base.abs() };
+            let shader = Lambert::new(&mesh, Mat4::IDENTITY, Mat4::IDENTITY)
+                .with_material(base, ambient);
+            let rel = Vec3::relative(&verts[0], &verts[1], &verts[2]);
+            let lanes = w.map(f32x8::from);
+            let shade = shader.fragment8(&rel, &lanes, mask);
+            prop_assert_eq!(matches!(shade, Shade8::Grey(_)), grey);
+            let rgb = match shade {
+                Shade8::Grey(g) => [g, g, g],
+                Shade8::Rgb(c) => c,
+            }
+            .map(F32s::to_array);
+            for k in (0..8).filter(|k| mask >> k & 1 == 1) {
+                let v = Vec3::from_relative(&rel, [w[0][k], w[1][k], w[2][k]]);
+                let one = shader.fragment(&v);
+                for (c, lane) in one.to_array().iter().zip(rgb) {
+                    prop_assert_eq!(c.to_bits(), lane[k].to_bits(), "lane {}", k);
+                }
+            }
+        }
     }
 }

@@ -748,7 +748,9 @@ fn span_weights8<V: Varying, F: F32s>(t: &Prepared<V>, n: u32, x0: u32, y: u32) 
 }
 
 /// Rasterizes the pieces of a draw's triangles.
-struct Raster<'a, S, C, L, const STD: bool> {
+/// `WIDE` fixes the traversal to `wide` at compile time (the AVX-512 copy is built
+/// for that alone, see [`Renderer::draw`]); otherwise `opts.traversal` picks it.
+struct Raster<'a, S, C, L, const STD: bool, const WIDE: bool> {
     shader: &'a S,
     depth: &'a mut DepthBuffer,
     color: &'a mut C,
@@ -758,8 +760,8 @@ struct Raster<'a, S, C, L, const STD: bool> {
     lanes: PhantomData<L>,
 }
 
-impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> EmitPiece<S::Varying>
-    for Raster<'_, S, C, L, STD>
+impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool, const WIDE: bool> EmitPiece<S::Varying>
+    for Raster<'_, S, C, L, STD, WIDE>
 {
     #[inline(always)]
     fn piece(&mut self, tri: &Prepared<S::Varying>) {
@@ -781,7 +783,11 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> EmitPiece<S::Varying>
             shaded: 0,
             lanes: PhantomData::<L>,
         };
-        self.opts.traversal.run_lanes::<L, _>(&tri.setup, &mut frag);
+        if WIDE {
+            crate::raster::traverse::wide_lanes::<L, _>(&tri.setup, &mut frag);
+        } else {
+            self.opts.traversal.run_lanes::<L, _>(&tri.setup, &mut frag);
+        }
         self.stats.fragments += frag.fragments;
         self.stats.shaded += frag.shaded;
     }
@@ -801,7 +807,10 @@ pub enum Isa {
     /// [`Isa::Avx2`]'s code on the same 256-bit lanes, compiled with AVX-512 (F, VL, BW,
     /// DQ) enabled as well. The lanes stay 8 wide; what the compiler gains is 32 vector
     /// registers instead of 16 (fewer per-triangle constants spilled and reloaded) and
-    /// mask registers for compares and blends.
+    /// mask registers for compares and blends. Built only for the default state
+    /// (depth `Less` with writes, perspective-correct) with the `wide` traversal, the
+    /// path that matters for speed: other draws run the AVX2 copy, which keeps the
+    /// build (and the tests' build) from compiling the whole loop a third time.
     Avx512,
 }
 
@@ -933,19 +942,20 @@ impl Renderer {
         }
         #[cfg(target_arch = "x86_64")]
         match self.isa {
-            Isa::Avx512 if Isa::Avx512.is_supported() => {
+            // Other states and traversals run the AVX2 copy (see `Isa::Avx512`).
+            Isa::Avx512 if Isa::Avx512.is_supported() && Self::is_fast(opts) => {
                 // SAFETY: the CPU has every feature `draw_avx512` enables, checked just above.
                 unsafe { self.draw_avx512(shader, cache, indices, opts, color) };
                 return;
             }
-            Isa::Avx2 if Isa::Avx2.is_supported() => {
+            Isa::Avx2 | Isa::Avx512 if Isa::Avx2.is_supported() => {
                 // SAFETY: the CPU has AVX2, FMA, POPCNT and BMI1, checked just above.
                 unsafe { self.draw_avx2(shader, cache, indices, opts, color) };
                 return;
             }
             _ => {}
         }
-        self.draw_triangles::<_, _, wide::i32x8>(shader, cache, indices, opts, color);
+        self.draw_triangles::<_, _, wide::i32x8, false>(shader, cache, indices, opts, color);
     }
 
     /// The draw loop compiled with AVX2 and FMA enabled and on [`crate::simd`]'s AVX2
@@ -963,7 +973,9 @@ impl Renderer {
         opts: &DrawOptions,
         color: &mut C,
     ) {
-        self.draw_triangles::<_, _, crate::simd::avx2::I32x8>(shader, cache, indices, opts, color);
+        self.draw_triangles::<_, _, crate::simd::avx2::I32x8, false>(
+            shader, cache, indices, opts, color,
+        );
     }
 
     /// [`Renderer::draw_avx2`]'s loop, on the same AVX2 lanes, with AVX-512 enabled
@@ -978,11 +990,13 @@ impl Renderer {
         opts: &DrawOptions,
         color: &mut C,
     ) {
-        self.draw_triangles::<_, _, crate::simd::avx2::I32x8>(shader, cache, indices, opts, color);
+        self.draw_triangles::<_, _, crate::simd::avx2::I32x8, true>(
+            shader, cache, indices, opts, color,
+        );
     }
 
     #[inline(always)]
-    fn draw_triangles<S: Shader, C: ColorTarget, L: I32s>(
+    fn draw_triangles<S: Shader, C: ColorTarget, L: I32s, const FAST_ONLY: bool>(
         &mut self,
         shader: &S,
         cache: &VertexCache<S::Varying>,
@@ -993,21 +1007,35 @@ impl Renderer {
         let target = self.target;
         let mut projected = std::mem::take(&mut self.projected);
         project_vertices(cache, target, &mut projected);
-        let std =
-            opts.depth == DepthState::default() && opts.interpolation == Interpolation::Perspective;
-        let stats = if std {
-            self.raster::<S, C, L, true>(shader, cache, &projected, indices, opts, color)
+        let stats = if FAST_ONLY {
+            debug_assert!(Self::is_fast(opts));
+            self.raster::<S, C, L, true, true>(shader, cache, &projected, indices, opts, color)
+        } else if Self::is_std(opts) {
+            self.raster::<S, C, L, true, false>(shader, cache, &projected, indices, opts, color)
         } else {
-            self.raster::<S, C, L, false>(shader, cache, &projected, indices, opts, color)
+            self.raster::<S, C, L, false, false>(shader, cache, &projected, indices, opts, color)
         };
         self.stats += stats;
         self.projected = projected;
     }
 
+    /// The default depth state and perspective-correct interpolation: the state the
+    /// fragment loop compiles as constants (see [`Fragments`]).
+    #[inline(always)]
+    fn is_std(opts: &DrawOptions) -> bool {
+        opts.depth == DepthState::default() && opts.interpolation == Interpolation::Perspective
+    }
+
+    /// [`Renderer::is_std`] with the `wide` traversal: what the AVX-512 copy is built for.
+    #[inline(always)]
+    fn is_fast(opts: &DrawOptions) -> bool {
+        Self::is_std(opts) && opts.traversal == Traversal::Wide
+    }
+
     /// The triangle loop of [`Renderer::draw_triangles`] for one `STD` (see
     /// [`Fragments`]).
     #[inline(always)]
-    fn raster<S: Shader, C: ColorTarget, L: I32s, const STD: bool>(
+    fn raster<S: Shader, C: ColorTarget, L: I32s, const STD: bool, const WIDE: bool>(
         &mut self,
         shader: &S,
         cache: &VertexCache<S::Varying>,
@@ -1017,7 +1045,7 @@ impl Renderer {
         color: &mut C,
     ) -> DrawStats {
         let target = self.target;
-        let mut raster = Raster::<S, C, L, STD> {
+        let mut raster = Raster::<S, C, L, STD, WIDE> {
             shader,
             depth: &mut self.depth,
             color,

@@ -941,21 +941,32 @@ impl Renderer {
             self.depth.reset(self.target.width, self.target.height);
         }
         #[cfg(target_arch = "x86_64")]
-        match self.isa {
-            // Other states and traversals run the AVX2 copy (see `Isa::Avx512`).
-            Isa::Avx512 if Isa::Avx512.is_supported() && Self::is_fast(opts) => {
-                // SAFETY: the CPU has every feature `draw_avx512` enables, checked just above.
+        match self.isa_for(opts) {
+            Isa::Avx512 => {
+                // SAFETY: `isa_for` picks an instruction set only when the CPU has it.
                 unsafe { self.draw_avx512(shader, cache, indices, opts, color) };
                 return;
             }
-            Isa::Avx2 | Isa::Avx512 if Isa::Avx2.is_supported() => {
-                // SAFETY: the CPU has AVX2, FMA, POPCNT and BMI1, checked just above.
+            Isa::Avx2 => {
+                // SAFETY: as above.
                 unsafe { self.draw_avx2(shader, cache, indices, opts, color) };
                 return;
             }
-            _ => {}
+            Isa::Baseline => {}
         }
         self.draw_triangles::<_, _, wide::i32x8, false>(shader, cache, indices, opts, color);
+    }
+
+    /// The instruction set a draw with `opts` runs on: [`Renderer::isa`] when the CPU
+    /// has it and that copy is built for these options (the AVX-512 one is built for
+    /// the default state with `wide` only), else the next one down.
+    #[must_use]
+    pub fn isa_for(&self, opts: &DrawOptions) -> Isa {
+        match self.isa {
+            Isa::Avx512 if Isa::Avx512.is_supported() && Self::is_fast(opts) => Isa::Avx512,
+            Isa::Avx2 | Isa::Avx512 if Isa::Avx2.is_supported() => Isa::Avx2,
+            _ => Isa::Baseline,
+        }
     }
 
     /// The draw loop compiled with AVX2 and FMA enabled and on [`crate::simd`]'s AVX2

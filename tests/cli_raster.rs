@@ -222,6 +222,23 @@ fn bench_render_reports_and_checks_its_instruction_set() {
     }
     assert!(covered.windows(2).all(|w| w[0] == w[1]), "{covered:?}");
     assert_ne!(covered[0], "0");
+    // The AVX-512 copy is built for the `wide` traversal only; others run and report AVX2.
+    if Isa::Avx512.is_supported() {
+        let (ok, out, err) = termrast(&[
+            "bench",
+            "render",
+            "--size",
+            "64x32",
+            "--frames",
+            "1",
+            "--isa",
+            "avx512",
+            "--traversal",
+            "scalar",
+        ]);
+        assert!(ok, "{err}");
+        assert_eq!(field(&out, "isa"), "avx2");
+    }
     let (ok, _, err) = termrast(&["bench", "render", "--frames", "1", "--isa", "sse9"]);
     assert!(!ok && err.contains("baseline, avx2, avx512"), "{err}");
     if let Some(missing) = Isa::ALL.into_iter().find(|isa| !isa.is_supported()) {

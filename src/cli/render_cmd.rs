@@ -232,7 +232,7 @@ pub struct BenchReport {
     pub triangles: usize,
     /// Covered fragments per frame (mean), overdraw included.
     pub covered_px: u64,
-    /// The draw loop's instruction set.
+    /// The instruction set the draw loop ran on (see [`crate::render::Renderer::isa_for`]).
     pub isa: Isa,
 }
 
@@ -284,6 +284,6 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
         min_ms: times[0],
         triangles: model.mesh.triangle_count(),
         covered_px: covered / u64::from(frames),
-        isa: frame.renderer.isa,
+        isa: frame.renderer.isa_for(&opts),
     })
 }

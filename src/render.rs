@@ -9,6 +9,7 @@
 //! Per-triangle work ([`prepare`]) and per-pixel work ([`Prepared::eval`]) are shared
 //! by the renderer and the probe, so the probe reports exactly what the renderer did.
 
+mod isa;
 pub mod shaders;
 pub mod standard;
 pub mod target;
@@ -29,6 +30,7 @@ use crate::raster::interp::{
 use crate::raster::setup::snap;
 use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup, Target, Traversal};
 use crate::simd::{F32s, I32s, each3};
+pub use isa::Isa;
 pub use target::{ColorTarget, Luma, Rgba8};
 
 /// A shader: the vertex stage produces clip-space positions and varyings for vertex
@@ -793,82 +795,6 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool, const WIDE: bool> Emit
     }
 }
 
-/// Which instructions the draw loop is compiled for. All give identical bits: only
-/// instruction selection differs (fused multiply-adds are written as such and are
-/// correctly rounded on every one), nothing is reordered.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Isa {
-    /// The build's target (baseline x86-64: 8-lane types run as two SSE halves).
-    Baseline,
-    /// x86-64 with AVX2 and FMA (and the POPCNT and BMI1 that every AVX2 CPU has, for
-    /// the per-group fragment counts and lane loops), chosen at run time when the CPU
-    /// has them.
-    Avx2,
-    /// [`Isa::Avx2`]'s code on the same 256-bit lanes, compiled with AVX-512 (F, VL, BW,
-    /// DQ) enabled as well. The lanes stay 8 wide; what the compiler gains is 32 vector
-    /// registers instead of 16 (fewer per-triangle constants spilled and reloaded) and
-    /// mask registers for compares and blends. Built only for the default state
-    /// (depth `Less` with writes, perspective-correct) with the `wide` traversal, the
-    /// path that matters for speed: other draws run the AVX2 copy, which keeps the
-    /// build (and the tests' build) from compiling the whole loop a third time.
-    Avx512,
-}
-
-impl Isa {
-    /// Every instruction set, from the most widely available.
-    pub const ALL: [Isa; 3] = [Isa::Baseline, Isa::Avx2, Isa::Avx512];
-
-    /// The best the running CPU supports.
-    #[must_use]
-    pub fn detect() -> Self {
-        Self::ALL
-            .into_iter()
-            .rev()
-            .find(|isa| isa.is_supported())
-            .unwrap_or(Isa::Baseline)
-    }
-
-    /// The instruction sets the running CPU supports (always including the baseline).
-    pub fn supported() -> impl Iterator<Item = Isa> {
-        Self::ALL.into_iter().filter(|isa| isa.is_supported())
-    }
-
-    /// Whether the running CPU has what this instruction set is compiled for.
-    #[must_use]
-    pub fn is_supported(self) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::is_x86_feature_detected as has;
-            let avx2 = || has!("avx2") && has!("fma") && has!("popcnt") && has!("bmi1");
-            match self {
-                Isa::Baseline => true,
-                Isa::Avx2 => avx2(),
-                Isa::Avx512 => {
-                    avx2()
-                        && has!("avx512f")
-                        && has!("avx512vl")
-                        && has!("avx512bw")
-                        && has!("avx512dq")
-                }
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            self == Isa::Baseline
-        }
-    }
-
-    /// The name used on the command line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Isa::Baseline => "baseline",
-            Isa::Avx2 => "avx2",
-            Isa::Avx512 => "avx512",
-        }
-    }
-}
-
 /// Owns the depth buffer and frame counters; draws meshes into a colour target.
 #[derive(Debug)]
 pub struct Renderer {
@@ -944,17 +870,17 @@ impl Renderer {
         match self.isa_for(opts) {
             Isa::Avx512 => {
                 // SAFETY: `isa_for` picks an instruction set only when the CPU has it.
-                unsafe { self.draw_avx512(shader, cache, indices, opts, color) };
+                unsafe { isa::avx512::draw(self, shader, cache, indices, opts, color) };
                 return;
             }
             Isa::Avx2 => {
                 // SAFETY: as above.
-                unsafe { self.draw_avx2(shader, cache, indices, opts, color) };
+                unsafe { isa::avx2::draw(self, shader, cache, indices, opts, color) };
                 return;
             }
             Isa::Baseline => {}
         }
-        self.draw_triangles::<_, _, wide::i32x8, false>(shader, cache, indices, opts, color);
+        isa::baseline::draw(self, shader, cache, indices, opts, color);
     }
 
     /// The instruction set a draw with `opts` runs on: [`Renderer::isa`] when the CPU
@@ -967,43 +893,6 @@ impl Renderer {
             Isa::Avx2 | Isa::Avx512 if Isa::Avx2.is_supported() => Isa::Avx2,
             _ => Isa::Baseline,
         }
-    }
-
-    /// The draw loop compiled with AVX2 and FMA enabled and on [`crate::simd`]'s AVX2
-    /// lanes, so 8-lane values are one 256-bit register instead of two 128-bit halves
-    /// and `mul_add` is one instruction. Only the instruction selection differs: no
-    /// operation is fused or reordered beyond what the code says, so the output is
-    /// bit-identical to the baseline path (the tests compare both).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1")]
-    unsafe fn draw_avx2<S: Shader, C: ColorTarget>(
-        &mut self,
-        shader: &S,
-        cache: &VertexCache<S::Varying>,
-        indices: &[u32],
-        opts: &DrawOptions,
-        color: &mut C,
-    ) {
-        self.draw_triangles::<_, _, crate::simd::avx2::I32x8, false>(
-            shader, cache, indices, opts, color,
-        );
-    }
-
-    /// [`Renderer::draw_avx2`]'s loop, on the same AVX2 lanes, with AVX-512 enabled
-    /// too (see [`Isa::Avx512`]): the same operations, so the same bits.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,popcnt,bmi1,avx512f,avx512vl,avx512bw,avx512dq")]
-    unsafe fn draw_avx512<S: Shader, C: ColorTarget>(
-        &mut self,
-        shader: &S,
-        cache: &VertexCache<S::Varying>,
-        indices: &[u32],
-        opts: &DrawOptions,
-        color: &mut C,
-    ) {
-        self.draw_triangles::<_, _, crate::simd::avx2::I32x8, true>(
-            shader, cache, indices, opts, color,
-        );
     }
 
     #[inline(always)]

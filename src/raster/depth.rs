@@ -160,6 +160,7 @@ impl DepthBuffer {
         if self.data.len() != len {
             // Contents are irrelevant: every tile is stale below.
             self.data.clear();
+            crate::memory::reserve_frame(&mut self.data, len);
             self.data.resize(len, DEPTH_CLEAR);
         }
         let tiles_x = width.div_ceil(TILE_W) as usize;

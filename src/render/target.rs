@@ -82,14 +82,17 @@ impl ColorTarget for Rgba8 {
     }
     #[inline(always)]
     fn put8_grey<F: F32s>(&mut self, start: usize, mask: u8, g: F) {
-        // One conversion; the byte is copied to red, green and blue by one multiply.
+        // One conversion; the byte is copied to red, green and blue by shifts (a
+        // multiply by 0x010101 is the same bits but ends the shading's longest
+        // dependency chain with ten cycles of latency).
         let v = to_u8x8(g);
-        let px = (v * F::I::splat(0x01_01_01)) | F::I::splat(0xFF << 24);
+        let px = v | v.shl::<8>() | v.shl::<16>() | F::I::splat(0xFF << 24);
         self.blend8(start, mask, px);
     }
     fn reset(&mut self, len: usize, c: Vec3) {
         let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0];
         self.0.clear();
+        crate::memory::reserve_frame(&mut self.0, len);
         self.0.resize(len, px);
     }
 }
@@ -112,6 +115,7 @@ impl ColorTarget for Luma {
     }
     fn reset(&mut self, len: usize, c: Vec3) {
         self.0.clear();
+        crate::memory::reserve_frame(&mut self.0, len);
         self.0.resize(len, luminance(c));
     }
 }

@@ -91,9 +91,18 @@ impl ColorTarget for Rgba8 {
     }
     fn reset(&mut self, len: usize, c: Vec3) {
         let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0];
-        self.0.clear();
-        crate::memory::reserve_frame(&mut self.0, len);
-        self.0.resize(len, px);
+        if self.0.len() != len {
+            self.0.clear();
+            crate::memory::reserve_frame(&mut self.0, len);
+            self.0.resize(len, px);
+        } else if px == [0; 4] {
+            // Black (the usual background): a byte fill, which compiles to `memset`,
+            // whose string stores clear a large frame without reading it first. A fill
+            // of 4-byte words is a vector loop that reads every line it writes.
+            bytemuck::cast_slice_mut::<[u8; 4], u8>(&mut self.0).fill(0);
+        } else {
+            self.0.fill(px);
+        }
     }
 }
 
@@ -176,6 +185,26 @@ mod tests {
         prop_assert_eq!(bits(&colour), bits(&reference));
         prop_assert_eq!(bits(&grey), bits(&grey_ref));
         Ok(())
+    }
+
+    /// A reset leaves every pixel the background, whatever the target held before and
+    /// whether its size changed (black takes its own byte-fill path).
+    #[test]
+    fn reset_fills_every_pixel_with_the_background() {
+        let (red, black) = (Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO);
+        let mut t = Rgba8::default();
+        for (len, c, want) in [
+            (5, red, [255, 0, 0, 0]),
+            (5, black, [0, 0, 0, 0]),
+            (5, red, [255, 0, 0, 0]),
+            (7, black, [0, 0, 0, 0]),
+            (7, Vec3::splat(0.5), [128, 128, 128, 0]),
+            (3, black, [0, 0, 0, 0]),
+        ] {
+            t.0.fill([9; 4]);
+            t.reset(len, c);
+            assert_eq!(t.0, vec![want; len], "{len} {c}");
+        }
     }
 
     fn channel() -> impl Strategy<Value = f32> {

@@ -1,11 +1,12 @@
 //! Frame-sized buffers and the pages behind them.
 //!
 //! A 1920×1080 frame keeps about 16 MB of depth and colour. With 4 KiB pages that is
-//! some 4000 pages, more than the CPU's second-level TLB holds, and triangles touch a
-//! new row of pixels every 7.5 KB: without huge pages, depth tests wait on page walks.
-//! Linux backs memory with 2 MiB transparent huge pages when asked (`madvise`, the
-//! default policy of most distributions), but only for pages not yet touched, so the
-//! advice is given when a buffer grows, before it is filled.
+//! some 4000 pages, more than a second-level TLB of 1–2 thousand entries holds, and
+//! triangles touch a new row of pixels every 7.5 KB: without huge pages, depth tests
+//! wait on page walks. Under the `madvise` policy Linux backs memory with 2 MiB
+//! transparent huge pages only where asked (under `always` it does anyway), and only
+//! for pages not yet touched, so the advice is given when a buffer grows, before it
+//! is filled.
 
 /// Buffers smaller than this are left alone: they cannot hold more than one aligned
 /// 2 MiB page and fit in the TLB anyway (every terminal-sized frame is far below).

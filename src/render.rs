@@ -43,29 +43,39 @@ pub trait Shader {
     /// Colour of a fragment.
     fn fragment(&self, v: &Self::Varying) -> Vec3;
 
-    /// Colours of up to 8 fragments of one triangle at once: lane `k` (for each set bit of `mask`) has weights `w[..][k]` for the
-    /// triangle's varyings in relative form `rel` (see [`Varying::relative`]). The
-    /// default interpolates and shades lane by lane; shaders override it with 8-lane
-    /// code that must give the same bits as [`Shader::fragment`] (the probe relies on it).
+    /// Colours of a group of fragments of one triangle at once (8 lanes per row of
+    /// pixels, `F::ROWS` rows): lane `k` (for each set bit of `mask`) has weights
+    /// `w[..][k]` for the triangle's varyings in relative form `rel` (see
+    /// [`Varying::relative`]). The default interpolates and shades lane by lane;
+    /// shaders override it with lane code that must give the same bits as
+    /// [`Shader::fragment`] (the probe relies on it).
     #[inline(always)]
-    fn fragment8<F: F32s>(&self, rel: &[Self::Varying; 3], w: &[F; 3], mask: u8) -> Shade8<F> {
+    fn fragment_lanes<F: F32s>(
+        &self,
+        rel: &[Self::Varying; 3],
+        w: &[F; 3],
+        mask: u32,
+    ) -> ShadeLanes<F> {
         let w = each3!(|i| w[i].to_array());
-        let mut out = [[0f32; 8]; 3];
+        let mut out = [F::Arr::default(); 3];
         let mut m = mask;
         while m != 0 {
             let k = m.trailing_zeros() as usize;
-            let v = Self::Varying::from_relative(rel, [w[0][k], w[1][k], w[2][k]]);
+            let lane = |a: &F::Arr| a.as_ref()[k];
+            let v = Self::Varying::from_relative(rel, [lane(&w[0]), lane(&w[1]), lane(&w[2])]);
             let c = self.fragment(&v);
-            (out[0][k], out[1][k], out[2][k]) = (c.x, c.y, c.z);
+            for (o, c) in out.iter_mut().zip([c.x, c.y, c.z]) {
+                o.as_mut()[k] = c;
+            }
             m &= m - 1;
         }
-        Shade8::Rgb(each3!(|i| F::from_array(out[i])))
+        ShadeLanes::Rgb(each3!(|i| F::from_array(out[i])))
     }
 }
 
-/// The colours of 8 fragments from [`Shader::fragment8`].
+/// The colours of a group of fragments from [`Shader::fragment_lanes`].
 #[derive(Clone, Copy, Debug)]
-pub enum Shade8<F> {
+pub enum ShadeLanes<F> {
     /// Red, green and blue lanes.
     Rgb([F; 3]),
     /// One value for all three channels: a grey shader says so, and the target
@@ -172,18 +182,18 @@ pub struct Prepared<V> {
 
 /// An edge value as the fragment stage sees it: `256·G + rem` in f32, from the reduced
 /// value `G` the traversal carries. Exact while the result is below 2^24 (triangles up
-/// to a few thousand pixels across), one rounding beyond; the scalar and 8-lane paths
+/// to a few thousand pixels across), one rounding beyond; the scalar and lane paths
 /// both use this form, so they agree bit for bit.
 #[inline(always)]
 fn edge_value(g: f32, rem: f32) -> f32 {
     // `g·256` is exact (a power-of-two scaling), so this equals the fused form of
-    // `edge_value8` bit for bit without being a library call off the FMA path.
+    // `edge_value_lanes` bit for bit without being a library call off the FMA path.
     g * 256.0 + rem
 }
 
-/// [`edge_value`] on 8 lanes, as one fused multiply-add.
+/// [`edge_value`] on lanes, as one fused multiply-add.
 #[inline(always)]
-fn edge_value8<F: F32s>(g: F, rem: f32) -> F {
+fn edge_value_lanes<F: F32s>(g: F, rem: f32) -> F {
     g.mul_add(F::splat(256.0), F::splat(rem))
 }
 
@@ -199,9 +209,9 @@ fn depth_of(q: [f32; 3], z_a: f32, zc: [f32; 2]) -> f32 {
     if 1.0 < d { 1.0 } else { d }
 }
 
-/// [`depth_of`] on 8 lanes.
+/// [`depth_of`] on lanes.
 #[inline(always)]
-fn depth_of8<F: F32s>(q: [F; 3], z_a: f32, zc: &[f32; 2]) -> F {
+fn depth_lanes<F: F32s>(q: [F; 3], z_a: f32, zc: &[f32; 2]) -> F {
     // `zc` by reference: by value, the pair is loaded as one 64-bit integer and
     // split into two broadcasts (six instructions a group instead of two).
     let d = q[2].mul_add(
@@ -211,9 +221,9 @@ fn depth_of8<F: F32s>(q: [F; 3], z_a: f32, zc: &[f32; 2]) -> F {
     F::splat(1.0).min(F::splat(0.0).max(d))
 }
 
-/// [`perspective_weights`] on 8 lanes.
+/// [`perspective_weights`] on lanes.
 #[inline(always)]
-fn perspective_weights8<F: F32s>(q: [F; 3], pc: [f32; 3]) -> [F; 3] {
+fn perspective_weights_lanes<F: F32s>(q: [F; 3], pc: [f32; 3]) -> [F; 3] {
     let c = each3!(|i| F::splat(pc[i]));
     let p = [q[0] * c[0], q[1] * c[1], q[2] * c[2]];
     let s = q[2].mul_add(c[2], q[1].mul_add(c[1], p[0]));
@@ -287,7 +297,7 @@ impl<V: Varying> Prepared<V> {
 
     /// The edge values weighing A, B and C (`F02`, `F03`, `F01`: each vertex's weight
     /// is the edge opposite it) from raw edge values, by the same f32 operations as the
-    /// 8-lane fragment loop (so both give identical bits).
+    /// lane fragment loop (so both give identical bits).
     #[inline(always)]
     fn vertex_edges(&self, f: [i64; 3]) -> [f32; 3] {
         let s = &self.setup;
@@ -625,31 +635,37 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> CoverageSink
     }
 
     /// Eight pixels from a traversal without lanes (or with `i64` lanes): the
-    /// reduced edge values are formed here, then shaded as in [`CoverageSink::edges8`].
+    /// reduced edge values are formed here, then shaded as in
+    /// [`CoverageSink::edge_lanes`]. With two-row lanes, the second row repeats the
+    /// first and is masked off.
     #[inline(always)]
     fn mask8(&mut self, y: u32, x0: u32, mask: u8) {
         if x0 as usize + 8 > self.width {
-            self.pixels(y, x0, mask);
+            self.pixels(y, x0, u32::from(mask));
             return;
         }
         let s = &self.tri.setup;
         let (xi, yi) = (i64::from(x0), i64::from(y));
         let g = each3!(|e| {
             let base = s.reduced_edge(e, xi, yi);
-            L::F::from_array(std::array::from_fn(|k| (base + k as i64 * s.i[e]) as f32))
+            let mut a = <L::F as F32s>::Arr::default();
+            for (k, v) in a.as_mut().iter_mut().enumerate() {
+                *v = (base + (k % 8) as i64 * s.i[e]) as f32;
+            }
+            L::F::from_array(a)
         });
-        self.shade8(y, x0, mask, g);
+        self.shade_lanes(y, x0, u32::from(mask), g);
     }
 
-    /// Eight pixels with the `wide` traversal's `i32x8` edge lanes: one
-    /// conversion per edge gives the exact edge values.
+    /// A group with the `wide` traversal's `i32` edge lanes: one conversion per edge
+    /// gives the exact edge values.
     #[inline(always)]
-    fn edges8<G: I32s>(&mut self, y: u32, x0: u32, mask: u8, g: &[G; 3]) {
+    fn edge_lanes<G: I32s>(&mut self, y: u32, x0: u32, mask: u32, g: &[G; 3]) {
         if x0 as usize + 8 > self.width {
             self.pixels(y, x0, mask);
             return;
         }
-        self.shade8(y, x0, mask, each3!(|e| g[e].to_f32()));
+        self.shade_lanes(y, x0, mask, each3!(|e| g[e].to_f32()));
     }
 }
 
@@ -671,34 +687,42 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
     }
 
     /// A group that reaches past the target (only in targets under 8 pixels wide, see
-    /// [`CoverageSink::mask8`]), pixel by pixel.
+    /// [`CoverageSink::mask8`]), pixel by pixel (bit `k` is pixel `k % 8` of row
+    /// `k / 8`).
     #[inline(never)]
-    fn pixels(&mut self, y: u32, x0: u32, mask: u8) {
+    fn pixels(&mut self, y: u32, x0: u32, mask: u32) {
         let mut m = mask;
         while m != 0 {
-            self.pixel(x0 + m.trailing_zeros(), y);
+            let k = m.trailing_zeros();
+            self.pixel(x0 + k % 8, y + k / 8);
             m &= m - 1;
         }
     }
 
-    /// Barycentrics, depth, the depth test and perspective weights of eight pixels in
-    /// 8 lanes from their reduced edge values `g` (as floats); shading runs on the lanes
-    /// that pass. The same operations in the same order as [`Prepared::eval`].
+    /// Barycentrics, depth, the depth test and perspective weights of a group (8
+    /// pixels per row, `F::ROWS` rows, bit `k` of `mask` for pixel `x0 + k % 8` of row
+    /// `y + k / 8`) from their reduced edge values `g` (as floats); shading runs on the
+    /// lanes that pass. The same operations in the same order as [`Prepared::eval`].
     #[inline(always)]
-    fn shade8<F: F32s>(&mut self, y: u32, x0: u32, mask: u8, g: [F; 3]) {
+    fn shade_lanes<F: F32s>(&mut self, y: u32, x0: u32, mask: u32, g: [F; 3]) {
         let t = self.tri;
         let start = y as usize * self.width + x0 as usize;
-        let fl = each3!(|e| edge_value8(g[e], t.edge_rem[e]));
+        // Rows below the first only when the mask has lanes there: the last row of the
+        // target has none below it.
+        let stride = if F::ROWS > 1 && mask >> 8 != 0 {
+            self.width
+        } else {
+            0
+        };
+        let fl = each3!(|e| edge_value_lanes(g[e], t.edge_rem[e]));
         let q = [fl[1], fl[2], fl[0]];
-        let depth = depth_of8(q, t.z[0], &t.zc);
+        let depth = depth_lanes(q, t.z[0], &t.zc);
         self.stats.fragments += u64::from(mask.count_ones());
         let (depth_state, interpolation) = self.state();
         let pass = if depth_state.uses_buffer() {
             counters::add(Stage::DepthTests, u64::from(mask.count_ones()));
-            let slot: &mut [f32; 8] = (&mut self.depth.real_mut()[start..start + 8])
-                .try_into()
-                .expect("8 lanes");
-            let old = F::from_array(*slot);
+            let buf = self.depth.real_mut();
+            let old = F::load_rows(buf, start, stride);
             let test = match depth_state.func {
                 DepthFunc::Less => depth.lt(old).bitmask(),
                 DepthFunc::LessEqual => depth.le(old).bitmask(),
@@ -706,8 +730,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
             };
             let pass = test & mask;
             if pass != 0 && depth_state.write {
-                let keep = F::I::from_bits(pass).cast_f32();
-                *slot = F::select(keep, depth, old).to_array();
+                depth.store_rows(buf, start, stride, pass);
             }
             pass
         } else {
@@ -717,36 +740,38 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
             return;
         }
         let w = match interpolation {
-            Interpolation::Perspective => perspective_weights8(q, t.pc),
+            Interpolation::Perspective => perspective_weights_lanes(q, t.pc),
             Interpolation::Affine => {
                 let ia = F::splat(t.inv_area2);
                 [q[0] * ia, q[1] * ia, q[2] * ia]
             }
-            mode => span_weights8(t, mode.span().unwrap_or(8), x0, y),
+            mode => span_weights_lanes(t, mode.span().unwrap_or(8), x0, y),
         };
-        match self.shader.fragment8(&t.rel, &w, pass) {
-            Shade8::Rgb(c) => self.color.put8(start, pass, &c),
-            Shade8::Grey(g) => self.color.put8_grey(start, pass, g),
+        match self.shader.fragment_lanes(&t.rel, &w, pass) {
+            ShadeLanes::Rgb(c) => self.color.put_lanes(start, stride, pass, &c),
+            ShadeLanes::Grey(g) => self.color.put_lanes_grey(start, stride, pass, g),
         }
         self.stats.shaded += u64::from(pass.count_ones());
     }
 }
 
-/// The subdivided modes' weights for the 8 pixels from `x0`: exact perspective weights
-/// at the ends of each pixel's span (computed once per distinct span end), linear in
-/// between, by the same operations as [`Prepared::weights`].
+/// The subdivided modes' weights for a group at `(x0, y)` (see
+/// [`Fragments::shade_lanes`]): exact perspective weights at the ends of each pixel's
+/// span (computed once per distinct span end), linear in between, by the same
+/// operations as [`Prepared::weights`].
 #[inline(always)]
-fn span_weights8<V: Varying, F: F32s>(t: &Prepared<V>, n: u32, x0: u32, y: u32) -> [F; 3] {
-    let mut out = [[0f32; 8]; 3];
-    let mut ends = (u32::MAX, [0f32; 3], [0f32; 3]);
-    for k in 0..8 {
-        let (a, frac) = span_position(x0 + k, n);
-        if ends.0 != a {
-            ends = (a, t.persp_at(a, y), t.persp_at(a + n, y));
+fn span_weights_lanes<V: Varying, F: F32s>(t: &Prepared<V>, n: u32, x0: u32, y: u32) -> [F; 3] {
+    let mut out = [F::Arr::default(); 3];
+    let mut ends = (u32::MAX, u32::MAX, [0f32; 3], [0f32; 3]);
+    for k in 0..8 * F::ROWS as u32 {
+        let (x, y) = (x0 + k % 8, y + k / 8);
+        let (a, frac) = span_position(x, n);
+        if (ends.0, ends.1) != (a, y) {
+            ends = (a, y, t.persp_at(a, y), t.persp_at(a + n, y));
         }
-        let w = span_lerp(ends.1, ends.2, frac);
+        let w = span_lerp(ends.2, ends.3, frac);
         for v in 0..3 {
-            out[v][k as usize] = w[v];
+            out[v].as_mut()[k as usize] = w[v];
         }
     }
     each3!(|i| F::from_array(out[i]))

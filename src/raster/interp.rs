@@ -67,7 +67,7 @@ macro_rules! vector_varying {
             }
             #[inline(always)]
             fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
-                // Fused: one rounding per term (a shader's `fragment8` repeats this).
+                // Fused: one rounding per term (a shader's `fragment_lanes` repeats this).
                 r[2].mul_add(Self::weight(w[2]), r[1].mul_add(Self::weight(w[1]), r[0]))
             }
             #[inline(always)]

@@ -33,15 +33,23 @@ pub trait CoverageSink {
         }
     }
 
-    /// [`CoverageSink::mask8`] with the traversal's edge lanes: lane `i` of `g[e]` is
-    /// `⌊(F0e + bias) / 256⌋` at the centre of pixel `x0 + i` (see
+    /// [`CoverageSink::mask8`] with the traversal's edge lanes, for a group of
+    /// `L::ROWS` rows of 8 pixels: bit `k` of `mask` (and lane `k` of `g[e]`) is pixel
+    /// `x0 + k % 8` of row `y + k / 8`, and lane `k` of `g[e]` is
+    /// `⌊(F0e + bias) / 256⌋` at that pixel's centre (see
     /// [`crate::raster::Setup::reduced_edge`]). A sink that needs the edge values (the
-    /// fragment stage) takes them from here instead of recomputing eight of them per
-    /// edge; lanes outside `mask` hold values too but are not covered.
+    /// fragment stage) takes them from here instead of recomputing them per edge; lanes
+    /// outside `mask` hold values too but are not covered, and rows below the last one
+    /// of the bounding box never have bits set.
     #[inline]
-    fn edges8<L: I32s>(&mut self, y: u32, x0: u32, mask: u8, g: &[L; 3]) {
+    fn edge_lanes<L: I32s>(&mut self, y: u32, x0: u32, mask: u32, g: &[L; 3]) {
         let _ = g;
-        self.mask8(y, x0, mask);
+        for r in 0..L::ROWS as u32 {
+            let m = (mask >> (8 * r)) as u8;
+            if m != 0 {
+                self.mask8(y + r, x0, m);
+            }
+        }
     }
 }
 

@@ -2,7 +2,7 @@
 
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
-use super::{Shade8, Shader};
+use super::{ShadeLanes, Shader};
 use crate::mesh::Mesh;
 use crate::simd::{F32s, each3};
 
@@ -29,7 +29,7 @@ pub struct Lambert<'a> {
     ambient: f32,
     /// `1 − ambient`.
     diffuse: f32,
-    /// Whether the three channels of `base` are equal (see [`Shade8::Grey`]).
+    /// Whether the three channels of `base` are equal (see [`ShadeLanes::Grey`]).
     grey: bool,
 }
 
@@ -77,7 +77,7 @@ impl Shader for Lambert<'_> {
     #[inline(always)]
     fn fragment(&self, n: &Vec3) -> Vec3 {
         // Normalise after interpolation (interpolated unit vectors are shorter than 1):
-        // l = max(n·L / |n|, 0). Written out, with fused multiply-adds, so `fragment8`
+        // l = max(n·L / |n|, 0). Written out, with fused multiply-adds, so `fragment_lanes`
         // can repeat it bit for bit.
         let lt = self.light;
         let len = n.z.mul_add(n.z, n.y.mul_add(n.y, n.x * n.x)).sqrt();
@@ -89,7 +89,7 @@ impl Shader for Lambert<'_> {
     }
 
     #[inline(always)]
-    fn fragment8<F: F32s>(&self, rel: &[Vec3; 3], w: &[F; 3], _mask: u8) -> Shade8<F> {
+    fn fragment_lanes<F: F32s>(&self, rel: &[Vec3; 3], w: &[F; 3], _mask: u32) -> ShadeLanes<F> {
         // `Varying::from_relative` lane by lane: a + (b − a)·w1 + (c − a)·w2, fused.
         let [a, ba, ca] = rel;
         let [x, y, z] = each3!(
@@ -109,9 +109,9 @@ impl Shader for Lambert<'_> {
         // A grey base (the standard scene's white) gives three equal channels: one
         // product and, in the target, one conversion.
         if self.grey {
-            Shade8::Grey(F::splat(b.x) * k)
+            ShadeLanes::Grey(F::splat(b.x) * k)
         } else {
-            Shade8::Rgb(each3!(|i| F::splat(b[i]) * k))
+            ShadeLanes::Rgb(each3!(|i| F::splat(b[i]) * k))
         }
     }
 }
@@ -150,7 +150,7 @@ mod tests {
     use super::Lambert;
     use crate::mesh::Mesh;
     use crate::raster::interp::Varying;
-    use crate::render::{Shade8, Shader};
+    use crate::render::{ShadeLanes, Shader};
     use crate::simd::F32s;
 
     fn vec3() -> impl Strategy<Value = Vec3> {
@@ -175,11 +175,11 @@ mod tests {
                 .with_material(base, ambient);
             let rel = Vec3::relative(&verts[0], &verts[1], &verts[2]);
             let lanes = w.map(f32x8::from);
-            let shade = shader.fragment8(&rel, &lanes, mask);
-            prop_assert_eq!(matches!(shade, Shade8::Grey(_)), grey);
+            let shade = shader.fragment_lanes(&rel, &lanes, mask.into());
+            prop_assert_eq!(matches!(shade, ShadeLanes::Grey(_)), grey);
             let rgb = match shade {
-                Shade8::Grey(g) => [g, g, g],
-                Shade8::Rgb(c) => c,
+                ShadeLanes::Grey(g) => [g, g, g],
+                ShadeLanes::Rgb(c) => c,
             }
             .map(F32s::to_array);
             for k in (0..8).filter(|k| mask >> k & 1 == 1) {

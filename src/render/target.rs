@@ -12,23 +12,27 @@ pub trait ColorTarget {
     /// Fills the whole target, resizing to `len` pixels only if needed.
     fn reset(&mut self, len: usize, c: Vec3);
 
-    /// Writes colour lane `k` (red, green, blue lanes) to pixel `start + k` for each
-    /// set bit `k` of `mask`; must store what [`ColorTarget::put`] would.
+    /// Writes colour lane `k` (red, green, blue lanes) of a group for each set bit `k`
+    /// of `mask`: to pixel `start + (k / 8)·stride + k % 8` (8 lanes per row, `F::ROWS`
+    /// rows `stride` pixels apart; a stride of 0 when only the first row has bits).
+    /// Must store what [`ColorTarget::put`] would.
     #[inline(always)]
-    fn put8<F: F32s>(&mut self, start: usize, mask: u8, c: &[F; 3]) {
+    fn put_lanes<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, c: &[F; 3]) {
         let c = each3!(|i| c[i].to_array());
         let mut m = mask;
         while m != 0 {
             let k = m.trailing_zeros() as usize;
-            self.put(start + k, Vec3::new(c[0][k], c[1][k], c[2][k]));
+            let lane = |a: &F::Arr| a.as_ref()[k];
+            let at = start + k / 8 * stride + k % 8;
+            self.put(at, Vec3::new(lane(&c[0]), lane(&c[1]), lane(&c[2])));
             m &= m - 1;
         }
     }
 
-    /// [`ColorTarget::put8`] of a grey colour: `g` in all three channels.
+    /// [`ColorTarget::put_lanes`] of a grey colour: `g` in all three channels.
     #[inline(always)]
-    fn put8_grey<F: F32s>(&mut self, start: usize, mask: u8, g: F) {
-        self.put8(start, mask, &[g, g, g]);
+    fn put_lanes_grey<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, g: F) {
+        self.put_lanes(start, stride, mask, &[g, g, g]);
     }
 }
 
@@ -47,24 +51,21 @@ pub fn to_u8(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
 
-/// [`to_u8`] on 8 lanes, bit for bit (NaN gives 0 in both).
+/// [`to_u8`] on lanes, bit for bit (NaN gives 0 in both).
 #[must_use]
 #[inline(always)]
-pub fn to_u8x8<F: F32s>(v: F) -> F::I {
+pub fn to_u8_lanes<F: F32s>(v: F) -> F::I {
     // max(NaN, 0) is 0, as NaN's `as u8` is in `to_u8`.
     let v = v.max(F::splat(0.0)).min(F::splat(1.0));
     (v * F::splat(255.0) + F::splat(0.5)).trunc_i32()
 }
 
 impl Rgba8 {
-    /// Stores packed RGBA words `px` into pixels `start..start + 8` where `mask` is
-    /// set, in one blended store.
+    /// Stores packed RGBA words `px` into the group's pixels where `mask` is set (see
+    /// [`ColorTarget::put_lanes`]), one blended or masked store per row.
     #[inline(always)]
-    fn blend8<I: I32s>(&mut self, start: usize, mask: u8, px: I) {
-        let dst: &mut [i32; 8] = bytemuck::cast_slice_mut(&mut self.0[start..start + 8])
-            .try_into()
-            .expect("8 pixels");
-        *dst = I::select(I::from_bits(mask), px, I::from_array(*dst)).to_array();
+    fn blend_lanes<I: I32s>(&mut self, start: usize, stride: usize, mask: u32, px: I) {
+        px.store_rows(bytemuck::cast_slice_mut(&mut self.0), start, stride, mask);
     }
 }
 
@@ -74,20 +75,20 @@ impl ColorTarget for Rgba8 {
         self.0[index] = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255];
     }
     #[inline(always)]
-    fn put8<F: F32s>(&mut self, start: usize, mask: u8, c: &[F; 3]) {
-        // Pack to little-endian RGBA words and blend all 8 pixels in one store.
-        let [r, g, b] = each3!(|i| to_u8x8(c[i]));
+    fn put_lanes<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, c: &[F; 3]) {
+        // Pack to little-endian RGBA words and blend each row's 8 pixels in one store.
+        let [r, g, b] = each3!(|i| to_u8_lanes(c[i]));
         let px = r | g.shl::<8>() | b.shl::<16>() | F::I::splat(0xFF << 24);
-        self.blend8(start, mask, px);
+        self.blend_lanes(start, stride, mask, px);
     }
     #[inline(always)]
-    fn put8_grey<F: F32s>(&mut self, start: usize, mask: u8, g: F) {
+    fn put_lanes_grey<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, g: F) {
         // One conversion; the byte is copied to red, green and blue by shifts (a
         // multiply by 0x010101 is the same bits but ends the shading's longest
         // dependency chain with ten cycles of latency).
-        let v = to_u8x8(g);
+        let v = to_u8_lanes(g);
         let px = v | v.shl::<8>() | v.shl::<16>() | F::I::splat(0xFF << 24);
-        self.blend8(start, mask, px);
+        self.blend_lanes(start, stride, mask, px);
     }
     fn reset(&mut self, len: usize, c: Vec3) {
         let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0];
@@ -137,14 +138,14 @@ impl<A: ColorTarget, B: ColorTarget> ColorTarget for (A, B) {
         self.1.put(index, c);
     }
     #[inline(always)]
-    fn put8<F: F32s>(&mut self, start: usize, mask: u8, c: &[F; 3]) {
-        self.0.put8(start, mask, c);
-        self.1.put8(start, mask, c);
+    fn put_lanes<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, c: &[F; 3]) {
+        self.0.put_lanes(start, stride, mask, c);
+        self.1.put_lanes(start, stride, mask, c);
     }
     #[inline(always)]
-    fn put8_grey<F: F32s>(&mut self, start: usize, mask: u8, g: F) {
-        self.0.put8_grey(start, mask, g);
-        self.1.put8_grey(start, mask, g);
+    fn put_lanes_grey<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, g: F) {
+        self.0.put_lanes_grey(start, stride, mask, g);
+        self.1.put_lanes_grey(start, stride, mask, g);
     }
     fn reset(&mut self, len: usize, c: Vec3) {
         self.0.reset(len, c);
@@ -159,32 +160,55 @@ mod tests {
     use wide::f32x8;
 
     use super::{ColorTarget, Luma, Rgba8};
-    use crate::simd::F32s;
+    use crate::simd::{F32s, each3};
 
-    /// The 8-lane stores write exactly what `put` writes, lane by lane, and leave
+    /// The lane stores write exactly what `put` writes, lane by lane, and leave
     /// unmasked pixels alone; the grey store equals the colour store of `[g, g, g]`.
-    fn check<C: ColorTarget + Clone>(
+    /// Lanes of `F`, from `rgb[channel][lane]` (8 per row, rows `stride` apart).
+    fn check<C: ColorTarget + Clone, F: F32s>(
         empty: C,
         bits: impl Fn(&C) -> Vec<u32>,
-        rgb: [[f32; 8]; 3],
-        mask: u8,
+        rgb: &[Vec<f32>; 3],
+        mask: u32,
+        stride: usize,
     ) -> Result<(), TestCaseError> {
-        let lanes = rgb.map(f32x8::from_array);
+        let lanes = each3!(|i| {
+            let mut a = F::Arr::default();
+            a.as_mut().copy_from_slice(&rgb[i][..8 * F::ROWS]);
+            F::from_array(a)
+        });
         let mut reference = empty.clone();
-        reference.reset(10, Vec3::new(0.25, 0.5, 0.75));
+        reference.reset(12 + 2 * stride, Vec3::new(0.25, 0.5, 0.75));
         let (mut colour, mut grey, mut grey_ref) =
             (reference.clone(), reference.clone(), reference.clone());
-        for (k, &red) in rgb[0].iter().enumerate() {
+        let lanes_of = |i: usize| rgb[i].iter().take(8 * F::ROWS);
+        for (k, ((&r, &g), &b)) in lanes_of(0).zip(lanes_of(1)).zip(lanes_of(2)).enumerate() {
             if mask >> k & 1 == 1 {
-                reference.put(1 + k, Vec3::new(red, rgb[1][k], rgb[2][k]));
-                grey_ref.put(1 + k, Vec3::splat(red));
+                let at = 1 + k / 8 * stride + k % 8;
+                reference.put(at, Vec3::new(r, g, b));
+                grey_ref.put(at, Vec3::splat(r));
             }
         }
-        colour.put8(1, mask, &lanes);
-        grey.put8_grey(1, mask, lanes[0]);
+        colour.put_lanes(1, stride, mask, &lanes);
+        grey.put_lanes_grey(1, stride, mask, lanes[0]);
         prop_assert_eq!(bits(&colour), bits(&reference));
         prop_assert_eq!(bits(&grey), bits(&grey_ref));
         Ok(())
+    }
+
+    /// [`check`] on every target type.
+    fn check_targets<F: F32s>(
+        rgb: &[Vec<f32>; 3],
+        mask: u32,
+        stride: usize,
+    ) -> Result<(), TestCaseError> {
+        // Bit patterns, so NaN luminance compares equal to itself.
+        let rgba = |c: &Rgba8| c.0.iter().map(|p| u32::from_le_bytes(*p)).collect();
+        let luma = |c: &Luma| c.0.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        check::<_, F>(Rgba8::default(), rgba, rgb, mask, stride)?;
+        check::<_, F>(Luma::default(), luma, rgb, mask, stride)?;
+        let both = |c: &(Rgba8, Luma)| [rgba(&c.0), luma(&c.1)].concat();
+        check::<_, F>((Rgba8::default(), Luma::default()), both, rgb, mask, stride)
     }
 
     /// A reset leaves every pixel the background, whatever the target held before and
@@ -219,17 +243,18 @@ mod tests {
 
     proptest! {
         #[test]
-        fn eight_lane_stores_equal_per_pixel_stores(
-            rgb in prop::array::uniform3(prop::array::uniform8(channel())),
-            mask in any::<u8>(),
+        fn lane_stores_equal_per_pixel_stores(
+            rgb in prop::array::uniform3(prop::collection::vec(channel(), 16)),
+            mask in any::<u16>(),
+            stride in 8usize..20,
         ) {
-            // Bit patterns, so NaN luminance compares equal to itself.
-            let rgba = |c: &Rgba8| c.0.iter().map(|p| u32::from_le_bytes(*p)).collect();
-            let luma = |c: &Luma| c.0.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-            check(Rgba8::default(), rgba, rgb, mask)?;
-            check(Luma::default(), luma, rgb, mask)?;
-            let both = |c: &(Rgba8, Luma)| [rgba(&c.0), luma(&c.1)].concat();
-            check((Rgba8::default(), Luma::default()), both, rgb, mask)?;
+            check_targets::<f32x8>(&rgb, u32::from(mask & 0xFF), stride)?;
+            #[cfg(target_arch = "x86_64")]
+            if crate::render::Isa::Avx512.is_supported() {
+                // SAFETY of the AVX-512 lanes: the CPU was checked just above.
+                check_targets::<crate::simd::avx512::F32x16>(&rgb, u32::from(mask), stride)?;
+                check_targets::<crate::simd::avx512::F32x16>(&rgb, u32::from(mask & 0xFF), 0)?;
+            }
         }
     }
 }

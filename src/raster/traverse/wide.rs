@@ -3,25 +3,30 @@ use wide::{i32x8, i64x4};
 use crate::raster::{CoverageSink, Setup};
 use crate::simd::{I32s, each3};
 
-/// 8 lanes of edge values, one per pixel of a row group.
+/// Edge values of a group: 8 lanes per row of pixels, [`Lanes::ROWS`] rows.
 trait Lanes: Copy {
-    /// `base + i·step` in lane `i`.
-    fn ramp(base: i64, step: i64) -> Self;
+    /// Rows per group (see [`I32s::ROWS`]).
+    const ROWS: u32;
+    /// `i·sx + r·sy` in the lane of pixel `i` of row `r`.
+    fn ramp(sx: i64, sy: i64) -> Self;
     fn splat(v: i64) -> Self;
     fn add(self, o: Self) -> Self;
-    /// Bit `i` set when lane `i` is ≥ 0 in all three.
-    fn inside_mask(a: Self, b: Self, c: Self) -> u8;
+    /// Bit `k` set when lane `k` is ≥ 0 in all three.
+    fn inside_mask(a: Self, b: Self, c: Self) -> u32;
     /// Hands a group to the sink, with the lanes when the sink can use them.
-    fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u8, f: &[Self; 3]);
+    fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u32, f: &[Self; 3]);
 }
 
 impl<L: I32s> Lanes for L {
+    const ROWS: u32 = L::ROWS as u32;
     #[inline(always)]
-    fn ramp(base: i64, step: i64) -> Self {
-        // Exact: `fits_i32` bounded every lane value before this path was chosen (and
-        // wrapping i32 arithmetic agrees with i64 on values that fit).
-        let iota = L::from_array([0, 1, 2, 3, 4, 5, 6, 7]);
-        L::splat(base as i32) + iota * L::splat(step as i32)
+    fn ramp(sx: i64, sy: i64) -> Self {
+        // Exact: `fits_i32` bounded every lane value before this path was chosen.
+        let mut a = L::Arr::default();
+        for (k, v) in a.as_mut().iter_mut().enumerate() {
+            *v = ((k % 8) as i64 * sx + (k / 8) as i64 * sy) as i32;
+        }
+        L::from_array(a)
     }
     #[inline(always)]
     fn splat(v: i64) -> Self {
@@ -32,13 +37,13 @@ impl<L: I32s> Lanes for L {
         self + o
     }
     #[inline(always)]
-    fn inside_mask(a: Self, b: Self, c: Self) -> u8 {
+    fn inside_mask(a: Self, b: Self, c: Self) -> u32 {
         // The OR of three values is negative iff one of them is: one sign-bit mask.
         !(a | b | c).bitmask()
     }
     #[inline(always)]
-    fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u8, f: &[Self; 3]) {
-        sink.edges8(y, x0, mask, f);
+    fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u32, f: &[Self; 3]) {
+        sink.edge_lanes(y, x0, mask, f);
     }
 }
 
@@ -47,9 +52,10 @@ impl<L: I32s> Lanes for L {
 struct Lanes64(i64x4, i64x4);
 
 impl Lanes for Lanes64 {
+    const ROWS: u32 = 1;
     #[inline(always)]
-    fn ramp(base: i64, step: i64) -> Self {
-        let l = |o: i64| i64x4::new(std::array::from_fn(|i| base + (i as i64 + o) * step));
+    fn ramp(sx: i64, _: i64) -> Self {
+        let l = |o: i64| i64x4::new(std::array::from_fn(|i| (i as i64 + o) * sx));
         Lanes64(l(0), l(4))
     }
     #[inline(always)]
@@ -61,15 +67,15 @@ impl Lanes for Lanes64 {
         Lanes64(self.0 + o.0, self.1 + o.1)
     }
     #[inline(always)]
-    fn inside_mask(a: Self, b: Self, c: Self) -> u8 {
-        let lo = (a.0 | b.0 | c.0).to_bitmask() as u8;
-        let hi = (a.1 | b.1 | c.1).to_bitmask() as u8;
-        !(lo | (hi << 4))
+    fn inside_mask(a: Self, b: Self, c: Self) -> u32 {
+        let lo = (a.0 | b.0 | c.0).to_bitmask();
+        let hi = (a.1 | b.1 | c.1).to_bitmask();
+        !(lo | (hi << 4)) & 0xFF
     }
     #[inline(always)]
-    fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u8, _: &[Self; 3]) {
+    fn emit<S: CoverageSink>(sink: &mut S, y: u32, x0: u32, mask: u32, _: &[Self; 3]) {
         // Values that need i64 lanes do not fit the sink's i32 lanes.
-        sink.mask8(y, x0, mask);
+        sink.mask8(y, x0, mask as u8);
     }
 }
 
@@ -87,15 +93,16 @@ fn reduced(s: &Setup) -> ([i64; 3], [i64; 3], [i64; 3]) {
 
 /// Whether every value the `wide` traversal forms for this setup fits in `i32`: the
 /// reduced edge values over the bounding box widened by the 7 pixels a group can
-/// overhang on either side, plus the group step `8·I`. The bound is the triangle
-/// inequality from the box origin (`|G0| + |I|·(w + 14) + |J|·h`): a few operations,
-/// conservative, and cheap because tiny triangles pay it as often as they cover pixels.
+/// overhang on either side and the row a two-row group can reach below it, plus the
+/// group step `8·I`. The bound is the triangle inequality from the box origin
+/// (`|G0| + |I|·(w + 14) + |J|·(h + 1)`): a few operations, conservative, and cheap
+/// because tiny triangles pay it as often as they cover pixels.
 #[must_use]
 #[inline(always)]
 pub fn fits_i32(s: &Setup) -> bool {
     let b = s.bbox;
     let (g, i, j) = reduced(s);
-    let (w, h) = (u64::from(b.width()) + 14, u64::from(b.height()));
+    let (w, h) = (u64::from(b.width()) + 14, u64::from(b.height()) + 1);
     let fits = |e: usize| {
         let (ax, ay) = (i[e].unsigned_abs(), j[e].unsigned_abs());
         g[e].unsigned_abs() + 8 * ax + ax * w + ay * h <= i32::MAX as u64
@@ -109,7 +116,9 @@ pub fn fits_i32(s: &Setup) -> bool {
 /// is walked only over the range its edges allow (slivers and large triangles skip the
 /// empty part of their box), in groups placed on that range rather than on multiples
 /// of 8 (see `walk_run`), and the lanes step by `8·I` in `i32x8` when the box allows it
-/// (almost always), else in two `i64x4`.
+/// (almost always), else in two `i64x4`. With two-row lanes ([`wide_lanes`] on the
+/// AVX-512 backend) a group covers 8 pixels of two rows and walks the union of the
+/// two rows' ranges; the coverage is the same pixel for pixel.
 #[inline(always)]
 pub fn wide<S: CoverageSink>(s: &Setup, sink: &mut S) {
     wide_lanes::<i32x8, S>(s, sink);
@@ -173,28 +182,52 @@ fn walk<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
     let (mut row, sx, sy) = reduced(s);
     let neg_inv = neg_reciprocals(sx);
     let step8 = each3!(|e| L::splat(sx[e] * 8));
-    // Lane offsets `i·sx`, built once per triangle; a group start is one splat and add.
-    let ramp = each3!(|e| L::ramp(0, sx[e]));
-    for y in b.y0..=b.y1 {
-        if let Some((lo, hi)) = row_range(row, sx, neg_inv, b.x0, b.x1) {
-            let at = GroupLanes { row, sx, x0: b.x0 };
-            walk_run(sink, y, lo, hi, b.x1, &at, &ramp, &step8);
+    // Lane offsets `i·sx + r·sy`, built once per triangle; a group start is one splat
+    // and add.
+    let ramp = each3!(|e| L::ramp(sx[e], sy[e]));
+    let mut y = b.y0;
+    loop {
+        // A group's rows: `L::ROWS`, fewer at the bottom of the box.
+        let two = L::ROWS == 2 && y < b.y1;
+        let mut range = row_range(row, sx, neg_inv, b.x0, b.x1);
+        if two {
+            let below = each3!(|e| row[e] + sy[e]);
+            range = match (range, row_range(below, sx, neg_inv, b.x0, b.x1)) {
+                (Some((a, b)), Some((c, d))) => Some((a.min(c), b.max(d))),
+                (r, None) | (None, r) => r,
+            };
         }
+        if let Some((lo, hi)) = range {
+            let at = GroupLanes { row, sx, x0: b.x0 };
+            let rows = if two { 0xFFFF } else { 0xFF };
+            walk_run(sink, y, (lo, hi, b.x1), rows, &at, &ramp, &step8);
+        }
+        if b.y1 - y < L::ROWS {
+            return;
+        }
+        y += L::ROWS;
         for e in 0..3 {
-            row[e] += sy[e];
+            row[e] += sy[e] * i64::from(L::ROWS);
         }
     }
 }
 
+/// An 8-pixel lane mask repeated for each row of a group, limited to `rows` (the
+/// group's rows that lie in the box: `0xFF` for one, `0xFFFF` for two).
+#[inline(always)]
+fn per_row(m: u8, rows: u32) -> u32 {
+    (u32::from(m) * 0x0101) & rows
+}
+
 /// [`walk`] for boxes at most 16 pixels wide (most triangles of a dense mesh): every
-/// row has the same one or two groups (see [`walk_run`]), so their lanes are the
-/// previous row's plus `J` and their masks are fixed per triangle.
+/// group row has the same one or two groups (see [`walk_run`]), so their lanes are the
+/// previous ones plus `J` per row and their masks are fixed per triangle.
 #[inline(always)]
 fn walk_narrow<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
     let b = s.bbox;
     let (row, sx, sy) = reduced(s);
-    let step_y = each3!(|e| L::splat(sy[e]));
-    let ramp = each3!(|e| L::ramp(0, sx[e]));
+    let step_y = each3!(|e| L::splat(sy[e] * i64::from(L::ROWS)));
+    let ramp = each3!(|e| L::ramp(sx[e], sy[e]));
     let at = GroupLanes { row, sx, x0: b.x0 };
     // One group, or one from x0 and one ending at x1 without the lanes the first had.
     let (n, x, mask) = if b.x1 - b.x0 < 8 {
@@ -209,17 +242,27 @@ fn walk_narrow<L: Lanes, S: CoverageSink>(s: &Setup, sink: &mut S) {
     // memory (on the sphere, 32 instructions per visited group with the rows'
     // overhead, against 23 this way; a version that swaps the two groups was worse).
     let (mut f, mut f2) = (at.at(x[0], &ramp), at.at(x[1], &ramp));
-    for y in b.y0..=b.y1 {
-        group(sink, y, x[0], mask[0], &f);
+    let mut y = b.y0;
+    loop {
+        let rows = if L::ROWS == 2 && y < b.y1 {
+            0xFFFF
+        } else {
+            0xFF
+        };
+        group(sink, y, x[0], per_row(mask[0], rows), &f);
         for e in 0..3 {
             f[e] = f[e].add(step_y[e]);
         }
         if n == 2 {
-            group(sink, y, x[1], mask[1], &f2);
+            group(sink, y, x[1], per_row(mask[1], rows), &f2);
             for e in 0..3 {
                 f2[e] = f2[e].add(step_y[e]);
             }
         }
+        if b.y1 - y < L::ROWS {
+            return;
+        }
+        y += L::ROWS;
     }
 }
 
@@ -265,28 +308,27 @@ fn lanes(a: u32, b: u32) -> u8 {
 
 /// One group at `x` with lanes `f`, limited to the lanes of `mask`.
 #[inline(always)]
-fn group<L: Lanes, S: CoverageSink>(sink: &mut S, y: u32, x: u32, mask: u8, f: &[L; 3]) {
+fn group<L: Lanes, S: CoverageSink>(sink: &mut S, y: u32, x: u32, mask: u32, f: &[L; 3]) {
     let m = L::inside_mask(f[0], f[1], f[2]) & mask;
     if m != 0 {
         L::emit(sink, y, x, m, f);
     }
 }
 
-/// The groups of the run `lo..=hi` of row `y` in a box ending at `x1` (at least 8
-/// pixels wide), whose lanes `at` gives. Groups start at the run, not at multiples of
-/// 8: 8-pixel groups from `lo`, stepped by `8·I`, the last one with the lanes past
+/// The groups of the run `lo..=hi` of the group row at `y` in a box ending at `x1`
+/// (at least 8 pixels wide), whose lanes `at` gives; `rows` limits the masks to the
+/// group's rows in the box (see [`per_row`]). Groups start at the run, not at multiples
+/// of 8: 8-pixel groups from `lo`, stepped by `8·I`, the last one with the lanes past
 /// `hi` masked off, so a run of `n` pixels takes `⌈n/8⌉` groups. A group that would
 /// reach past the box is moved left to end at `x1`, with the lanes already visited
 /// masked off: the box lies in the target, so every group does too. That needs the
 /// lanes recomputed, which only rows near the box's right side pay.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn walk_run<L: Lanes, S: CoverageSink>(
     sink: &mut S,
     y: u32,
-    lo: u32,
-    hi: u32,
-    x1: u32,
+    (lo, hi, x1): (u32, u32, u32),
+    rows: u32,
     at: &GroupLanes,
     ramp: &[L; 3],
     step8: &[L; 3],
@@ -306,7 +348,7 @@ fn walk_run<L: Lanes, S: CoverageSink>(
             mask
         };
         // One call site: the sink's fragment code is inlined once per traversal.
-        group(sink, y, x, mask, &f);
+        group(sink, y, x, per_row(mask, rows), &f);
         if x + 7 >= hi {
             return;
         }

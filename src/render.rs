@@ -659,12 +659,17 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> CoverageSink
 
     /// A group with the `wide` traversal's `i32` edge lanes: one conversion per edge
     /// gives the exact edge values.
+    ///
+    /// Groups reach past the target only in targets under 8 pixels wide, which the
+    /// two-row lanes never see ([`Renderer::isa_for`]): their loop then has no call in
+    /// it, which would make the compiler keep the lanes in memory across every group.
     #[inline(always)]
     fn edge_lanes<G: I32s>(&mut self, y: u32, x0: u32, mask: u32, g: &[G; 3]) {
-        if x0 as usize + 8 > self.width {
+        if G::ROWS == 1 && x0 as usize + 8 > self.width {
             self.pixels(y, x0, mask);
             return;
         }
+        debug_assert!(x0 as usize + 8 <= self.width, "a group past the target");
         self.shade_lanes(y, x0, mask, each3!(|e| g[e].to_f32()));
     }
 }
@@ -910,11 +915,13 @@ impl Renderer {
 
     /// The instruction set a draw with `opts` runs on: [`Renderer::isa`] when the CPU
     /// has it and that copy is built for these options (the AVX-512 one is built for
-    /// the default state with `wide` only), else the next one down.
+    /// the default state with `wide` only, on targets at least 8 pixels wide: see
+    /// [`Fragments::edge_lanes`]), else the next one down.
     #[must_use]
     pub fn isa_for(&self, opts: &DrawOptions) -> Isa {
+        let avx512 = Self::is_fast(opts) && self.target.width >= 8;
         match self.isa {
-            Isa::Avx512 if Isa::Avx512.is_supported() && Self::is_fast(opts) => Isa::Avx512,
+            Isa::Avx512 if Isa::Avx512.is_supported() && avx512 => Isa::Avx512,
             Isa::Avx2 | Isa::Avx512 if Isa::Avx2.is_supported() => Isa::Avx2,
             _ => Isa::Baseline,
         }

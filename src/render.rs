@@ -693,8 +693,10 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
 
     /// A group that reaches past the target (only in targets under 8 pixels wide, see
     /// [`CoverageSink::mask8`]), pixel by pixel (bit `k` is pixel `k % 8` of row
-    /// `k / 8`).
-    #[inline(never)]
+    /// `k / 8`). Inlined: a call in the group loop, even one never taken, makes the
+    /// compiler keep the loop's lanes in memory (all vector registers are lost across
+    /// a call); inlined, the AVX2 copy ran the sphere in 0.84× the time.
+    #[inline(always)]
     fn pixels(&mut self, y: u32, x0: u32, mask: u32) {
         let mut m = mask;
         while m != 0 {

@@ -917,8 +917,9 @@ impl Renderer {
 
     /// The instruction set a draw with `opts` runs on: [`Renderer::isa`] when the CPU
     /// has it and that copy is built for these options (the AVX-512 one is built for
-    /// the default state with `wide` only, on targets at least 8 pixels wide: see
-    /// [`Fragments::edge_lanes`]), else the next one down.
+    /// the default state with `wide` only, on targets at least 8 pixels wide, so that
+    /// its group loop needs no per-pixel fallback for groups past the target's edge),
+    /// else the next one down.
     #[must_use]
     pub fn isa_for(&self, opts: &DrawOptions) -> Isa {
         let avx512 = Self::is_fast(opts) && self.target.width >= 8;

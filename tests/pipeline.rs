@@ -16,7 +16,7 @@ use termrast::raster::{Target, Traversal};
 use termrast::render::standard::{Model, StandardFrame, StandardView};
 use termrast::render::target::{luminance, to_u8};
 use termrast::render::wire::Mode;
-use termrast::render::{Cull, DrawOptions, Isa, Rgba8, Shader, VertexCache, transform};
+use termrast::render::{Cull, DrawOptions, Isa, Renderer, Rgba8, Shader, VertexCache, transform};
 
 /// A quad tilted in depth whose attribute is its texture coordinate (u across, v along
 /// the slope), checked against the analytic ray–plane intersection in f64.
@@ -304,6 +304,32 @@ fn traversals_and_instruction_sets_draw_identical_frames() {
                 );
             }
         }
+    }
+}
+
+/// The AVX-512 copy's two-row groups have no per-pixel fallback for groups past the
+/// target's edge, so it is chosen only for targets at least a group (8 pixels) wide;
+/// narrower ones run the AVX2 copy (or the baseline).
+#[test]
+fn avx512_copy_runs_only_on_targets_a_group_wide() {
+    let next_down = if Isa::Avx2.is_supported() {
+        Isa::Avx2
+    } else {
+        Isa::Baseline
+    };
+    for (width, wide_enough) in [(1, false), (7, false), (8, true), (1920, true)] {
+        let mut renderer = Renderer::new(Target::new(width, 4));
+        renderer.isa = Isa::Avx512;
+        let want = if wide_enough && Isa::Avx512.is_supported() {
+            Isa::Avx512
+        } else {
+            next_down
+        };
+        assert_eq!(
+            renderer.isa_for(&DrawOptions::default()),
+            want,
+            "{width} wide"
+        );
     }
 }
 

@@ -272,6 +272,23 @@ impl I32s for i32x8 {
     }
 }
 
+/// `impl $tr for $t` by the intrinsic `$intr` on the register inside `$t`, for the
+/// register backends below.
+#[cfg(target_arch = "x86_64")]
+macro_rules! binop {
+    ($t:ident, $tr:ident, $f:ident, $intr:ident) => {
+        impl $tr for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn $f(self, o: $t) -> $t {
+                // SAFETY: values of this type exist only on CPUs with the instructions
+                // its module names (module docs).
+                $t(unsafe { $intr(self.0, o.0) })
+            }
+        }
+    };
+}
+
 /// The AVX2 backend.
 ///
 /// Its values may only exist on a CPU with AVX2 and FMA: the types are crate-private and
@@ -293,18 +310,6 @@ pub(crate) mod avx2 {
     #[derive(Clone, Copy, Debug)]
     pub(crate) struct I32x8(__m256i);
 
-    macro_rules! binop {
-        ($t:ident, $tr:ident, $f:ident, $intr:ident) => {
-            impl $tr for $t {
-                type Output = $t;
-                #[inline(always)]
-                fn $f(self, o: $t) -> $t {
-                    // SAFETY: values of this type exist only on CPUs with AVX2 and FMA (module docs).
-                    $t(unsafe { $intr(self.0, o.0) })
-                }
-            }
-        };
-    }
     binop!(F32x8, Add, add, _mm256_add_ps);
     binop!(F32x8, Sub, sub, _mm256_sub_ps);
     binop!(F32x8, Mul, mul, _mm256_mul_ps);
@@ -467,18 +472,6 @@ pub(crate) mod avx512 {
     #[derive(Clone, Copy, Debug)]
     pub(crate) struct I32x16(__m512i);
 
-    macro_rules! binop {
-        ($t:ident, $tr:ident, $f:ident, $intr:ident) => {
-            impl $tr for $t {
-                type Output = $t;
-                #[inline(always)]
-                fn $f(self, o: $t) -> $t {
-                    // SAFETY: values of this type exist only on CPUs with AVX-512 (module docs).
-                    $t(unsafe { $intr(self.0, o.0) })
-                }
-            }
-        };
-    }
     binop!(F32x16, Add, add, _mm512_add_ps);
     binop!(F32x16, Sub, sub, _mm512_sub_ps);
     binop!(F32x16, Mul, mul, _mm512_mul_ps);

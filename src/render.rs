@@ -43,6 +43,13 @@ pub trait Shader {
     /// Colour of a fragment.
     fn fragment(&self, v: &Self::Varying) -> Vec3;
 
+    /// Whether [`Shader::fragment_lanes`] is lane code of the shader's own rather than
+    /// the default loop over single fragments. Only such shaders get the 16-lane
+    /// AVX-512 copy of the draw loop (see [`Renderer::isa_for`]): a loop over single
+    /// fragments gains nothing from wider lanes, and that copy of every pipeline of
+    /// the scenes made the tests' build take half as long again.
+    const LANE_CODE: bool = false;
+
     /// Colours of a group of fragments of one triangle at once (8 lanes per row of
     /// pixels, `F::ROWS` rows): lane `k` (for each set bit of `mask`) has weights
     /// `w[..][k]` for the triangle's varyings in relative form `rel` (see
@@ -899,18 +906,20 @@ impl Renderer {
             self.depth.reset(self.target.width, self.target.height);
         }
         #[cfg(target_arch = "x86_64")]
-        match self.isa_for(opts) {
-            Isa::Avx512 => {
+        {
+            let isa = self.isa_for::<S>(opts);
+            // `S::LANE_CODE` first, as its own condition: a constant `false` there keeps
+            // the compiler from building the AVX-512 copy for this shader at all.
+            if S::LANE_CODE && isa == Isa::Avx512 {
                 // SAFETY: `isa_for` picks an instruction set only when the CPU has it.
                 unsafe { isa::avx512::draw(self, shader, cache, indices, opts, color) };
                 return;
             }
-            Isa::Avx2 => {
-                // SAFETY: as above.
+            if isa != Isa::Baseline {
+                // SAFETY: as above; AVX-512 implies AVX2.
                 unsafe { isa::avx2::draw(self, shader, cache, indices, opts, color) };
                 return;
             }
-            Isa::Baseline => {}
         }
         isa::baseline::draw(self, shader, cache, indices, opts, color);
     }
@@ -920,9 +929,11 @@ impl Renderer {
     /// the default state with `wide` only, on targets at least 8 pixels wide, so that
     /// its group loop needs no per-pixel fallback for groups past the target's edge),
     /// else the next one down.
+    /// Only shaders with lane code of their own ([`Shader::LANE_CODE`]) get the AVX-512
+    /// copy.
     #[must_use]
-    pub fn isa_for(&self, opts: &DrawOptions) -> Isa {
-        let avx512 = Self::is_fast(opts) && self.target.width >= 8;
+    pub fn isa_for<S: Shader>(&self, opts: &DrawOptions) -> Isa {
+        let avx512 = S::LANE_CODE && Self::is_fast(opts) && self.target.width >= 8;
         match self.isa {
             Isa::Avx512 if Isa::Avx512.is_supported() && avx512 => Isa::Avx512,
             Isa::Avx2 | Isa::Avx512 if Isa::Avx2.is_supported() => Isa::Avx2,

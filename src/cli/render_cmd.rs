@@ -10,6 +10,7 @@ use clap::Args;
 use crate::mesh::Mesh;
 use crate::raster::interp::Interpolation;
 use crate::raster::{Target, Traversal};
+use crate::render::shaders::Lambert;
 use crate::render::standard::{Model, RADIANS_PER_FRAME, StandardFrame, StandardView};
 use crate::render::wire::Mode;
 use crate::render::{Cull, DrawOptions, Isa, Rgba8};
@@ -284,6 +285,6 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
         min_ms: times[0],
         triangles: model.mesh.triangle_count(),
         covered_px: covered / u64::from(frames),
-        isa: frame.renderer.isa_for(&opts),
+        isa: frame.renderer.isa_for::<Lambert<'_>>(&opts),
     })
 }

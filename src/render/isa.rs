@@ -22,7 +22,8 @@ pub enum Isa {
     /// rows of 8 pixels, so the dense meshes' small triangles take half the groups
     /// (the 65k sphere at 1080p: 297k instead of 579k), and each group has 32 vector
     /// registers for its per-triangle constants and mask registers for its compares,
-    /// blends and masked stores. Built only for the default state
+    /// blends and masked stores. Built only for shaders with lane code of their own
+    /// ([`crate::render::Shader::LANE_CODE`]) and the default state
     /// (depth `Less` with writes, perspective-correct) with the `wide` traversal, the
     /// path that matters for speed: other draws run the AVX2 copy, which keeps the
     /// build (and the tests' build) from compiling the whole loop a third time.

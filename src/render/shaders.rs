@@ -65,6 +65,7 @@ impl<'a> Lambert<'a> {
 
 impl Shader for Lambert<'_> {
     type Varying = Vec3;
+    const LANE_CODE: bool = true;
 
     #[inline(always)]
     fn vertex(&self, index: u32) -> (Vec4, Vec3) {

@@ -700,11 +700,31 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
 
     /// A group that reaches past the target (only in targets under 8 pixels wide, see
     /// [`CoverageSink::mask8`]), pixel by pixel (bit `k` is pixel `k % 8` of row
-    /// `k / 8`). Inlined: a call in the group loop, even one never taken, makes the
-    /// compiler keep the loop's lanes in memory (all vector registers are lost across
-    /// a call); inlined, the AVX2 copy ran the sphere in 0.84× the time.
+    /// `k / 8`).
+    ///
+    /// Inlined for shaders with lane code ([`Shader::LANE_CODE`]): a call in the group
+    /// loop, even one never taken, makes the compiler keep the loop's lanes in memory
+    /// (all vector registers are lost across a call); inlined, the AVX2 copy ran the
+    /// sphere in 0.84× the time. For the others it stays a call: inlining their
+    /// single-fragment shading at every group of every copy made the build longer.
     #[inline(always)]
     fn pixels(&mut self, y: u32, x0: u32, mask: u32) {
+        if S::LANE_CODE {
+            self.pixels_inline(y, x0, mask);
+        } else {
+            self.pixels_call(y, x0, mask);
+        }
+    }
+
+    /// [`Fragments::pixels`] out of line.
+    #[inline(never)]
+    fn pixels_call(&mut self, y: u32, x0: u32, mask: u32) {
+        self.pixels_inline(y, x0, mask);
+    }
+
+    /// [`Fragments::pixels`] in line.
+    #[inline(always)]
+    fn pixels_inline(&mut self, y: u32, x0: u32, mask: u32) {
         let mut m = mask;
         while m != 0 {
             let k = m.trailing_zeros();

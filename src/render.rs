@@ -45,9 +45,9 @@ pub trait Shader {
 
     /// Whether [`Shader::fragment_lanes`] is lane code of the shader's own rather than
     /// the default loop over single fragments. Only such shaders get the 16-lane
-    /// AVX-512 copy of the draw loop (see [`Renderer::isa_for`]): a loop over single
-    /// fragments gains nothing from wider lanes, and that copy of every pipeline of
-    /// the scenes made the tests' build take half as long again.
+    /// AVX-512 copy of the draw loop (see [`Renderer::isa_for`]), and an inlined
+    /// per-pixel fallback in the others: a loop over single fragments gains nothing
+    /// from wider lanes, and only makes the build longer.
     const LANE_CODE: bool = false;
 
     /// Colours of a group of fragments of one triangle at once (8 lanes per row of

@@ -146,6 +146,33 @@ fn row8<T>(s: &mut [T], start: usize) -> &mut [T; 8] {
     (&mut s[start..start + 8]).try_into().expect("8 lanes")
 }
 
+/// [`F32s::load_rows`] of the one-row (8-lane) backends.
+#[inline(always)]
+fn load_row8<F: F32s<Arr = [f32; 8]>>(s: &[f32], start: usize) -> F {
+    F::from_array(s[start..start + 8].try_into().expect("8 lanes"))
+}
+
+/// [`F32s::store_rows`] of the one-row backends: one blended store of the row.
+#[inline(always)]
+fn store_row8<F: F32s<Arr = [f32; 8]>>(v: F, s: &mut [f32], start: usize, mask: u32) {
+    let slot = row8(s, start);
+    let keep = F::I::from_bits(mask).cast_f32();
+    *slot = F::select(keep, v, F::from_array(*slot)).to_array();
+}
+
+/// [`I32s::load_rows`] of the one-row backends.
+#[inline(always)]
+fn load_row8_i<I: I32s<Arr = [i32; 8]>>(s: &[i32], start: usize) -> I {
+    I::from_array(s[start..start + 8].try_into().expect("8 lanes"))
+}
+
+/// [`I32s::store_rows`] of the one-row backends: one blended store of the row.
+#[inline(always)]
+fn store_row8_i<I: I32s<Arr = [i32; 8]>>(v: I, s: &mut [i32], start: usize, mask: u32) {
+    let slot = row8(s, start);
+    *slot = I::select(I::from_bits(mask), v, I::from_array(*slot)).to_array();
+}
+
 impl F32s for f32x8 {
     type I = i32x8;
     const ROWS: usize = 1;
@@ -164,13 +191,11 @@ impl F32s for f32x8 {
     }
     #[inline(always)]
     fn load_rows(s: &[f32], start: usize, _: usize) -> Self {
-        Self::from_array(s[start..start + 8].try_into().expect("8 lanes"))
+        load_row8(s, start)
     }
     #[inline(always)]
     fn store_rows(self, s: &mut [f32], start: usize, _: usize, mask: u32) {
-        let slot = row8(s, start);
-        let keep = i32x8::from_bits(mask).cast_f32();
-        *slot = F32s::select(keep, self, Self::from_array(*slot)).to_array();
+        store_row8(self, s, start, mask);
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -235,12 +260,11 @@ impl I32s for i32x8 {
     }
     #[inline(always)]
     fn load_rows(s: &[i32], start: usize, _: usize) -> Self {
-        Self::from_array(s[start..start + 8].try_into().expect("8 lanes"))
+        load_row8_i(s, start)
     }
     #[inline(always)]
     fn store_rows(self, s: &mut [i32], start: usize, _: usize, mask: u32) {
-        let slot = row8(s, start);
-        *slot = I32s::select(Self::from_bits(mask), self, Self::from_array(*slot)).to_array();
+        store_row8_i(self, s, start, mask);
     }
     #[inline(always)]
     fn from_bits(mask: u32) -> Self {
@@ -300,7 +324,7 @@ pub(crate) mod avx2 {
     use std::arch::x86_64::*;
     use std::ops::{Add, BitAnd, BitOr, Div, Mul, Sub};
 
-    use super::{F32s, I32s, from_bits8, row8};
+    use super::{F32s, I32s, from_bits8, load_row8, load_row8_i, store_row8, store_row8_i};
 
     /// Eight `f32` lanes in one `ymm` register.
     #[derive(Clone, Copy, Debug)]
@@ -341,13 +365,11 @@ pub(crate) mod avx2 {
         }
         #[inline(always)]
         fn load_rows(s: &[f32], start: usize, _: usize) -> Self {
-            Self::from_array(s[start..start + 8].try_into().expect("8 lanes"))
+            load_row8(s, start)
         }
         #[inline(always)]
         fn store_rows(self, s: &mut [f32], start: usize, _: usize, mask: u32) {
-            let slot = row8(s, start);
-            let keep = I32x8::from_bits(mask).cast_f32();
-            *slot = F32s::select(keep, self, Self::from_array(*slot)).to_array();
+            store_row8(self, s, start, mask);
         }
         #[inline(always)]
         fn sqrt(self) -> Self {
@@ -411,12 +433,11 @@ pub(crate) mod avx2 {
         }
         #[inline(always)]
         fn load_rows(s: &[i32], start: usize, _: usize) -> Self {
-            Self::from_array(s[start..start + 8].try_into().expect("8 lanes"))
+            load_row8_i(s, start)
         }
         #[inline(always)]
         fn store_rows(self, s: &mut [i32], start: usize, _: usize, mask: u32) {
-            let slot = row8(s, start);
-            *slot = I32s::select(Self::from_bits(mask), self, Self::from_array(*slot)).to_array();
+            store_row8_i(self, s, start, mask);
         }
         #[inline(always)]
         fn from_bits(mask: u32) -> Self {

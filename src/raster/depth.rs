@@ -215,37 +215,57 @@ impl DepthBuffer {
     }
 
     /// Makes the tiles overlapping pixels `x0..=x1` × `y0..=y1` real: stale ones are
-    /// filled with [`DEPTH_CLEAR`]. Costs a few word tests when they already are.
+    /// filled with [`DEPTH_CLEAR`]. Costs a word test per tile row when they already
+    /// are: the renderer calls this once per triangle, so a box within one bit word
+    /// (every box narrower than 64 tiles that does not cross a word's edge) takes a
+    /// loop of its own, with the span computed once.
     #[inline(always)]
     pub fn make_real(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
         let (tx0, tx1) = ((x0 / TILE_W) as usize, (x1 / TILE_W) as usize);
-        for ty in (y0 / TILE_H) as usize..=(y1 / TILE_H) as usize {
-            for w in tx0 / 64..=tx1 / 64 {
-                let lo = if w == tx0 / 64 { tx0 % 64 } else { 0 };
-                let hi = if w == tx1 / 64 { tx1 % 64 } else { 63 };
-                let span = (!0u64 >> (63 - hi)) & (!0u64 << lo);
-                let word = &mut self.stale[ty * self.words + w];
-                let mut m = *word & span;
-                if m == 0 {
-                    continue;
-                }
-                *word &= !span;
-                while m != 0 {
-                    self.fill_tile(w * 64 + m.trailing_zeros() as usize, ty);
-                    m &= m - 1;
-                }
+        let (ty0, ty1) = ((y0 / TILE_H) as usize, (y1 / TILE_H) as usize);
+        let (w0, w1) = (tx0 / 64, tx1 / 64);
+        if w0 == w1 {
+            let span = word_span(tx0 % 64, tx1 % 64);
+            for ty in ty0..ty1 + 1 {
+                self.make_word_real(ty, w0, span);
+            }
+            return;
+        }
+        for ty in ty0..ty1 + 1 {
+            for w in w0..w1 + 1 {
+                let lo = if w == w0 { tx0 % 64 } else { 0 };
+                let hi = if w == w1 { tx1 % 64 } else { 63 };
+                self.make_word_real(ty, w, word_span(lo, hi));
             }
         }
     }
 
+    /// Makes the stale tiles of `span` in bit word `w` of tile row `ty` real.
+    #[inline(always)]
+    fn make_word_real(&mut self, ty: usize, w: usize, span: u64) {
+        let word = &mut self.stale[ty * self.words + w];
+        let m = *word & span;
+        if m != 0 {
+            *word &= !span;
+            self.fill_tiles(w, ty, m);
+        }
+    }
+
+    /// Fills the tiles of the set bits `m` of bit word `w` in tile row `ty`. Out of
+    /// line: it runs about once per tile per frame, against once per triangle for the
+    /// test before it.
     #[inline(never)]
-    fn fill_tile(&mut self, tx: usize, ty: usize) {
-        let w = self.width as usize;
-        let x0 = tx * TILE_W as usize;
-        let x1 = (x0 + TILE_W as usize).min(w);
+    fn fill_tiles(&mut self, w: usize, ty: usize, mut m: u64) {
+        let width = self.width as usize;
         let y0 = ty * TILE_H as usize;
-        for y in y0..(y0 + TILE_H as usize).min(self.height as usize) {
-            self.data[y * w + x0..y * w + x1].fill(DEPTH_CLEAR);
+        let y1 = (y0 + TILE_H as usize).min(self.height as usize);
+        while m != 0 {
+            let x0 = (w * 64 + m.trailing_zeros() as usize) * TILE_W as usize;
+            let x1 = (x0 + TILE_W as usize).min(width);
+            for y in y0..y1 {
+                self.data[y * width + x0..y * width + x1].fill(DEPTH_CLEAR);
+            }
+            m &= m - 1;
         }
     }
 
@@ -254,6 +274,12 @@ impl DepthBuffer {
     pub(crate) fn real_mut(&mut self) -> &mut [f32] {
         &mut self.data
     }
+}
+
+/// Bits `lo..=hi` of a word (`lo ≤ hi ≤ 63`).
+#[inline(always)]
+fn word_span(lo: usize, hi: usize) -> u64 {
+    (!0u64 >> (63 - hi)) & (!0u64 << lo)
 }
 
 #[cfg(test)]

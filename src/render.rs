@@ -492,7 +492,7 @@ pub fn prepare_projected<V: Varying>(
         ClipOutcome::Rejected => return PrepareOutcome::Rejected,
         ClipOutcome::Inside => {
             let var = each3!(|i| tri[i].var);
-            seen.add(setup_piece(t, 0, clipped, proj, var, target, cull), emit);
+            seen.add(setup_piece((t, 0, clipped), proj, var, target, cull, emit));
         }
         ClipOutcome::Clipped => {
             let Some(poly) = clip_straddling(tri, guard) else {
@@ -501,7 +501,7 @@ pub fn prepare_projected<V: Varying>(
             for (i, tri) in poly.triangles().enumerate() {
                 let proj = each3!(|i| Projected::of(tri[i].pos, target, guard));
                 let var = each3!(|i| tri[i].var);
-                seen.add(setup_piece(t, i, clipped, proj, var, target, cull), emit);
+                seen.add(setup_piece((t, i, clipped), proj, var, target, cull, emit));
             }
         }
     }
@@ -520,42 +520,38 @@ struct Seen {
 }
 
 impl Seen {
-    /// Hands a set-up piece on and notes what became of it. A method rather than a
-    /// closure so that it inlines (see [`EmitPiece`]).
+    /// Notes what became of a piece.
     #[inline(always)]
-    fn add<V>(&mut self, piece: Piece<V>, emit: &mut impl EmitPiece<V>) {
+    fn add(&mut self, piece: Piece) {
         match piece {
-            Piece::Drawn(p) => {
-                emit.piece(&p);
-                self.drawn = true;
-            }
+            Piece::Drawn => self.drawn = true,
             Piece::Culled => self.culled = true,
             Piece::Rejected => {}
         }
     }
 }
 
-// Built and matched within one inlined call, never stored: boxing the large variant
-// would allocate per triangle.
-#[allow(clippy::large_enum_variant)]
-enum Piece<V> {
-    Drawn(Prepared<V>),
+/// What became of one piece of a triangle.
+enum Piece {
+    /// Set up and handed to the [`EmitPiece`].
+    Drawn,
     Culled,
     Rejected,
 }
 
 /// Sets up one (possibly clipped) triangle whose vertices all have w > 0, from their
-/// projections.
+/// projections, and hands it to `emit`. The record is built where `emit` reads it:
+/// returned in an enum and then passed on, it was copied once more per triangle (64
+/// instructions on the AVX2 copy).
 #[inline(always)]
 fn setup_piece<V: Varying>(
-    t: u32,
-    piece: usize,
-    clipped: bool,
+    (t, piece, clipped): (u32, usize, bool),
     proj: [Projected; 3],
     var: [V; 3],
     target: Target,
     cull: Cull,
-) -> Piece<V> {
+    emit: &mut impl EmitPiece<V>,
+) -> Piece {
     // Not `iter().all(..)`: it stays out of line in the AVX2 draw loop.
     if !(proj[0].snapped && proj[1].snapped && proj[2].snapped) {
         return Piece::Rejected;
@@ -580,7 +576,7 @@ fn setup_piece<V: Varying>(
     let ia = 1.0 / setup.area2 as f64;
     let slope = |i: usize| ((f64::from(z[i]) - f64::from(z[0])) * ia) as f32;
     let zc = [slope(1), slope(2)];
-    Piece::Drawn(Prepared {
+    emit.piece(&Prepared {
         triangle: t,
         piece: piece as u8,
         clipped,
@@ -593,7 +589,8 @@ fn setup_piece<V: Varying>(
         rel: V::relative(&var[0], &var[1], &var[2]),
         inv_area2: ia as f32,
         edge_rem,
-    })
+    });
+    Piece::Drawn
 }
 
 /// The fragment loop of one triangle: receives coverage from the traversal.

@@ -23,13 +23,14 @@ pub struct Lambert<'a> {
     pub normal_matrix: Mat3,
     /// Towards the light, normalised, world space.
     pub light: Vec3,
-    /// Surface colour, set with the ambient term by [`Lambert::with_material`], which
-    /// also derives the two values below once per draw rather than per fragment.
-    base: Vec3,
-    ambient: f32,
-    /// `1 − ambient`.
-    diffuse: f32,
-    /// Whether the three channels of `base` are equal (see [`ShadeLanes::Grey`]).
+    /// Surface colour times `1 − ambient`: the colour is `l·lit + unlit` for the
+    /// cosine `l`, one fused multiply-add per channel. Set with the ambient term by
+    /// [`Lambert::with_material`], once per draw rather than per fragment.
+    lit: Vec3,
+    /// Surface colour times the ambient term.
+    unlit: Vec3,
+    /// Whether the three channels of the surface colour are equal (see
+    /// [`ShadeLanes::Grey`]).
     grey: bool,
 }
 
@@ -42,9 +43,8 @@ impl<'a> Lambert<'a> {
             mvp: view_proj * model,
             normal_matrix: Mat3::from_mat4(model).inverse().transpose(),
             light: standard_light(),
-            base: Vec3::ONE,
-            ambient: 0.0,
-            diffuse: 1.0,
+            lit: Vec3::ONE,
+            unlit: Vec3::ZERO,
             grey: true,
         }
         .with_material(Vec3::ONE, 0.08)
@@ -54,9 +54,8 @@ impl<'a> Lambert<'a> {
     #[must_use]
     pub fn with_material(self, base: Vec3, ambient: f32) -> Self {
         Self {
-            base,
-            ambient,
-            diffuse: 1.0 - ambient,
+            lit: base * (1.0 - ambient),
+            unlit: base * ambient,
             grey: base.x == base.y && base.y == base.z,
             ..self
         }
@@ -85,8 +84,7 @@ impl Shader for Lambert<'_> {
         let d = n.z.mul_add(lt.z, n.y.mul_add(lt.y, n.x * lt.x));
         let l = d / len;
         let l = if l > 0.0 { l } else { 0.0 };
-        let k = l.mul_add(self.diffuse, self.ambient);
-        self.base * k
+        Vec3::splat(l).mul_add(self.lit, self.unlit)
     }
 
     #[inline(always)]
@@ -105,14 +103,13 @@ impl Shader for Lambert<'_> {
         let l = d / len;
         // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
         let l = l.max(F::splat(0.0));
-        let k = l.mul_add(F::splat(self.diffuse), F::splat(self.ambient));
-        let b = self.base;
+        let (lit, unlit) = (self.lit, self.unlit);
         // A grey base (the standard scene's white) gives three equal channels: one
-        // product and, in the target, one conversion.
+        // multiply-add and, in the target, one conversion.
         if self.grey {
-            ShadeLanes::Grey(F::splat(b.x) * k)
+            ShadeLanes::Grey(l.mul_add(F::splat(lit.x), F::splat(unlit.x)))
         } else {
-            ShadeLanes::Rgb(each3!(|i| F::splat(b[i]) * k))
+            ShadeLanes::Rgb(each3!(|i| l.mul_add(F::splat(lit[i]), F::splat(unlit[i]))))
         }
     }
 }

@@ -25,7 +25,7 @@ use crate::raster::clip::{
 };
 use crate::raster::depth::{DepthBuffer, DepthFunc, DepthState};
 use crate::raster::interp::{
-    Interpolation, Varying, perspective_weights, span_lerp, span_position,
+    Interpolation, Varying, perspective_weights, projective_weights, span_lerp, span_position,
 };
 use crate::raster::setup::snap;
 use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup, Target, Traversal};
@@ -228,6 +228,16 @@ fn depth_lanes<F: F32s>(q: [F; 3], z_a: f32, zc: &[f32; 2]) -> F {
     F::splat(1.0).min(F::splat(0.0).max(d))
 }
 
+/// [`projective_weights`] on lanes.
+#[inline(always)]
+fn projective_weights_lanes<F: F32s>(q: [F; 3], pc: [f32; 3]) -> [F; 3] {
+    [
+        q[0] * F::splat(pc[0]),
+        q[1] * F::splat(pc[1]),
+        q[2] * F::splat(pc[2]),
+    ]
+}
+
 /// [`perspective_weights`] on lanes.
 #[inline(always)]
 fn perspective_weights_lanes<F: F32s>(q: [F; 3], pc: [f32; 3]) -> [F; 3] {
@@ -332,6 +342,7 @@ impl<V: Varying> Prepared<V> {
                 let (a, t) = span_position(e.x, n);
                 span_lerp(self.persp_at(a, e.y), self.persp_at(a + n, e.y), t)
             }
+            _ if V::PROJECTIVE => projective_weights(self.vertex_edges(e.f), self.pc),
             _ => e.persp,
         }
     }
@@ -771,6 +782,9 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
             return;
         }
         let w = match interpolation {
+            Interpolation::Perspective if S::Varying::PROJECTIVE => {
+                projective_weights_lanes(q, t.pc)
+            }
             Interpolation::Perspective => perspective_weights_lanes(q, t.pc),
             Interpolation::Affine => {
                 let ia = F::splat(t.inv_area2);

@@ -7,12 +7,24 @@
 //! Screen-space barycentrics `(u, v, w)` come from the exact integer edge values
 //! divided by the doubled area (so they are exact up to one rounding and do not lose
 //! precision far from the origin). Perspective-correct weights follow eq. 16–23:
-//! interpolate `1/w` and `attribute/w` linearly and divide once per pixel.
+//! interpolate `1/w` and `attribute/w` linearly and divide once per pixel. A varying
+//! whose shader needs only its direction ([`Direction`], Lambert's normal) skips the
+//! division: `attribute/w` is a positive multiple of the attribute, which the
+//! shader's normalisation removes.
 
 use glam::{Vec2, Vec3, Vec4};
 
 /// A set of per-vertex attributes interpolated across a triangle.
 pub trait Varying: Copy {
+    /// Whether only the value's direction matters to the shader that reads it (a
+    /// normal it normalises per pixel): the value times any positive factor shades
+    /// the same. Such a varying is interpolated under perspective as `attribute/w`
+    /// itself, eq. 21's numerator `Σ vᵢ·bᵢ/wᵢ`, without eq. 23's division by the
+    /// interpolated `1/w`, which saves a division per pixel: it receives weights that
+    /// sum to the interpolated `1/w` rather than to 1 (see [`projective_weights`]).
+    /// Its relative form is then the vertex values themselves (see [`Direction`]).
+    const PROJECTIVE: bool = false;
+
     /// The interpolated value for weights `w` (summing to 1), computed relative to `a`
     /// as `a + (b − a)·w[1] + (c − a)·w[2]`: a constant attribute stays exactly
     /// constant and a pixel at vertex A gets exactly A's value, which the sum
@@ -22,12 +34,14 @@ pub trait Varying: Copy {
     }
 
     /// `[a, b − a, c − a]`, what [`Varying::from_relative`] interpolates: computed once
-    /// per triangle instead of once per pixel.
+    /// per triangle instead of once per pixel. ([`Varying::PROJECTIVE`] varyings keep
+    /// `[a, b, c]`.)
     fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3];
 
     /// `r[0] + r[1]·w[1] + r[2]·w[2]` (as two fused multiply-adds, inner first) for `r`
     /// from [`Varying::relative`]: exactly [`Varying::weighted`] of the vertices `r`
-    /// came from.
+    /// came from. ([`Varying::PROJECTIVE`] varyings: `r[0]·w[0] + r[1]·w[1] +
+    /// r[2]·w[2]`, the same way.)
     fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self;
 
     /// `a + (b − a)·t`, used by clipping (linear in clip space).
@@ -78,6 +92,35 @@ macro_rules! vector_varying {
     )*};
 }
 vector_varying!(f32, Vec2, Vec3, Vec4);
+
+/// A direction that its shader normalises per pixel (Lambert's normal): a
+/// [`Varying::PROJECTIVE`] varying, interpolated as `Σ vᵢ·bᵢ/wᵢ` (a positive multiple
+/// of the perspective-correct value) in the default perspective mode, and as an
+/// ordinary weighted sum, from the vertex values, in the others.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Direction(pub Vec3);
+
+impl Varying for Direction {
+    const PROJECTIVE: bool = true;
+    #[inline(always)]
+    fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3] {
+        // Weights that need not sum to 1 leave nothing to take relative to a vertex.
+        [*a, *b, *c]
+    }
+    #[inline(always)]
+    fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
+        // Fused, inner first, from `a·w[0]` (Lambert's lane code repeats this).
+        let a = r[0].0 * w[0];
+        Self(
+            r[2].0
+                .mul_add(Vec3::splat(w[2]), r[1].0.mul_add(Vec3::splat(w[1]), a)),
+        )
+    }
+    #[inline(always)]
+    fn lerp(a: &Self, b: &Self, t: f32) -> Self {
+        Self(a.0 + (b.0 - a.0) * t)
+    }
+}
 
 impl Varying for () {
     #[inline(always)]
@@ -185,15 +228,24 @@ pub fn span_lerp(wa: [f32; 3], wb: [f32; 3], t: f32) -> [f32; 3] {
     ]
 }
 
+/// The numerators of eq. 23 from the edge values `q` weighing each vertex and
+/// `c[i] = (1/w_i) / area2`: `p_i = q_i·c_i` is `b_i/w_i`, and `Σ p_i` the
+/// interpolated `1/w`. The weights of [`Varying::PROJECTIVE`] varyings.
+#[must_use]
+#[inline(always)]
+pub fn projective_weights(q: [f32; 3], c: [f32; 3]) -> [f32; 3] {
+    [q[0] * c[0], q[1] * c[1], q[2] * c[2]]
+}
+
 /// Perspective-correct weights (eq. 23) from the edge values `q` weighing each vertex
-/// and `c[i] = (1/w_i) / area2`, plus the interpolated `1/w` itself: `p_i = q_i·c_i`
-/// is `b_i/w_i`, and the weights are `p_i / Σ p_j`. The sum is of non-negative terms
-/// inside the triangle, so it never cancels.
+/// and `c[i] = (1/w_i) / area2`, plus the interpolated `1/w` itself: the weights are
+/// `p_i / Σ p_j` for `p` from [`projective_weights`]. The sum is of non-negative
+/// terms inside the triangle, so it never cancels.
 #[must_use]
 #[inline(always)]
 pub fn perspective_weights(q: [f32; 3], c: [f32; 3]) -> ([f32; 3], f32) {
     // Same operations, same order, as the renderer's 8-lane path.
-    let p = [q[0] * c[0], q[1] * c[1], q[2] * c[2]];
+    let p = projective_weights(q, c);
     let s = q[2].mul_add(c[2], q[1].mul_add(c[1], p[0]));
     let r = 1.0 / s;
     ([p[0] * r, p[1] * r, p[2] * r], s)

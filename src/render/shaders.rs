@@ -4,6 +4,7 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use super::{ShadeLanes, Shader};
 use crate::mesh::Mesh;
+use crate::raster::interp::Direction;
 use crate::simd::{F32s, each3};
 
 /// The standard light direction (towards the light, world space), normalised.
@@ -13,7 +14,9 @@ pub fn standard_light() -> Vec3 {
 }
 
 /// Per-pixel Lambert shading from interpolated normals (the benchmark scene).
-/// Varying: the world-space normal.
+/// Varying: the world-space normal, as a [`Direction`]: the shading normalises it, so
+/// it is interpolated without the perspective division (see
+/// [`Varying::PROJECTIVE`](crate::raster::interp::Varying::PROJECTIVE)).
 #[derive(Clone, Debug)]
 pub struct Lambert<'a> {
     pub mesh: &'a Mesh,
@@ -63,19 +66,19 @@ impl<'a> Lambert<'a> {
 }
 
 impl Shader for Lambert<'_> {
-    type Varying = Vec3;
+    type Varying = Direction;
     const LANE_CODE: bool = true;
 
     #[inline(always)]
-    fn vertex(&self, index: u32) -> (Vec4, Vec3) {
+    fn vertex(&self, index: u32) -> (Vec4, Direction) {
         let i = index as usize;
         let p = self.mesh.positions[i];
         let n = self.mesh.normals.get(i).copied().unwrap_or(Vec3::Z);
-        (self.mvp * p.extend(1.0), self.normal_matrix * n)
+        (self.mvp * p.extend(1.0), Direction(self.normal_matrix * n))
     }
 
     #[inline(always)]
-    fn fragment(&self, n: &Vec3) -> Vec3 {
+    fn fragment(&self, &Direction(n): &Direction) -> Vec3 {
         // Normalise after interpolation (interpolated unit vectors are shorter than 1):
         // l = max(n·L / |n|, 0). Written out, with fused multiply-adds, so `fragment_lanes`
         // can repeat it bit for bit.
@@ -88,12 +91,17 @@ impl Shader for Lambert<'_> {
     }
 
     #[inline(always)]
-    fn fragment_lanes<F: F32s>(&self, rel: &[Vec3; 3], w: &[F; 3], _mask: u32) -> ShadeLanes<F> {
-        // `Varying::from_relative` lane by lane: a + (b − a)·w1 + (c − a)·w2, fused.
-        let [a, ba, ca] = rel;
-        let [x, y, z] = each3!(
-            |i| F::splat(ca[i]).mul_add(w[2], F::splat(ba[i]).mul_add(w[1], F::splat(a[i])))
-        );
+    fn fragment_lanes<F: F32s>(
+        &self,
+        rel: &[Direction; 3],
+        w: &[F; 3],
+        _mask: u32,
+    ) -> ShadeLanes<F> {
+        // `Direction::from_relative` lane by lane: a·w0 + b·w1 + c·w2, fused.
+        let [a, b, c] = [rel[0].0, rel[1].0, rel[2].0];
+        let [x, y, z] =
+            each3!(|i| F::splat(c[i])
+                .mul_add(w[2], F::splat(b[i]).mul_add(w[1], F::splat(a[i]) * w[0])));
         let len = z.mul_add(z, y.mul_add(y, x * x)).sqrt();
         let lt = self.light;
         let d = z.mul_add(
@@ -147,7 +155,7 @@ mod tests {
 
     use super::Lambert;
     use crate::mesh::Mesh;
-    use crate::raster::interp::Varying;
+    use crate::raster::interp::{Direction, Varying, perspective_weights, projective_weights};
     use crate::render::{ShadeLanes, Shader};
     use crate::simd::F32s;
 
@@ -155,12 +163,40 @@ mod tests {
         prop::array::uniform3(-2.0f32..2.0).prop_map(Vec3::from)
     }
 
+    /// A unit normal within 60° of +z, so that interpolating three of them never comes
+    /// near the zero vector, where the normalisation is ill-conditioned.
+    fn normal() -> impl Strategy<Value = Vec3> {
+        (-1.0f32..1.0, -1.0f32..1.0).prop_map(|(x, y)| Vec3::new(x, y, 2.0).normalize())
+    }
+
     proptest! {
+        /// Interpolating Lambert's normal without the perspective division shades as
+        /// the perspective-correct normal does, up to rounding: the two differ by the
+        /// positive factor `Σ pᵢ`, which the normalisation removes.
+        #[test]
+        fn projective_normals_shade_as_perspective_correct_ones(
+            n in prop::array::uniform3(normal()),
+            q in (1.0f32..1e6, 0.0f32..1e6, 0.0f32..1e6),
+            c in prop::array::uniform3(1e-9f32..1e-3),
+            ambient in 0.0f32..0.5,
+        ) {
+            let mesh = Mesh::teapot();
+            let shader = Lambert::new(&mesh, Mat4::IDENTITY, Mat4::IDENTITY)
+                .with_material(Vec3::ONE, ambient);
+            let q = [q.0, q.1, q.2];
+            let (persp, _) = perspective_weights(q, c);
+            let exact = shader.fragment(&Direction(Vec3::weighted(&n[0], &n[1], &n[2], persp)));
+            let d = n.map(Direction);
+            let fast = shader.fragment(&Direction::weighted(&d[0], &d[1], &d[2], projective_weights(q, c)));
+            let err = (exact - fast).abs().max_element();
+            prop_assert!(err <= 2e-6, "{exact} against {fast}");
+        }
+
         /// Lambert's 8-lane fragments equal its per-pixel ones bit for bit, for grey
         /// bases (one channel) and coloured ones (three), on every lane of the mask.
         #[test]
         fn lambert_lanes_equal_single_fragments(
-            verts in prop::array::uniform3(vec3()),
+            verts in prop::array::uniform3(vec3().prop_map(Direction)),
             w in prop::array::uniform3(prop::array::uniform8(0.0f32..1.0)),
             base in vec3(),
             grey in any::<bool>(),
@@ -171,7 +207,7 @@ mod tests {
             let base = if grey { Vec3::splat(base.x.abs()) } else { base.abs() };
             let shader = Lambert::new(&mesh, Mat4::IDENTITY, Mat4::IDENTITY)
                 .with_material(base, ambient);
-            let rel = Vec3::relative(&verts[0], &verts[1], &verts[2]);
+            let rel = Direction::relative(&verts[0], &verts[1], &verts[2]);
             let lanes = w.map(f32x8::from);
             let shade = shader.fragment_lanes(&rel, &lanes, mask.into());
             prop_assert_eq!(matches!(shade, ShadeLanes::Grey(_)), grey);
@@ -181,7 +217,7 @@ mod tests {
             }
             .map(F32s::to_array);
             for k in (0..8).filter(|k| mask >> k & 1 == 1) {
-                let v = Vec3::from_relative(&rel, [w[0][k], w[1][k], w[2][k]]);
+                let v = Direction::from_relative(&rel, [w[0][k], w[1][k], w[2][k]]);
                 let one = shader.fragment(&v);
                 for (c, lane) in one.to_array().iter().zip(rgb) {
                     prop_assert_eq!(c.to_bits(), lane[k].to_bits(), "lane {}", k);

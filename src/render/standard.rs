@@ -13,6 +13,7 @@ use super::{ColorTarget, DrawOptions, Renderer, VertexCache, transform};
 use crate::camera::Camera;
 use crate::mesh::Mesh;
 use crate::raster::Target;
+use crate::raster::interp::Direction;
 
 /// Rotation per frame of the benchmark, radians about y.
 pub const RADIANS_PER_FRAME: f32 = 0.05;
@@ -68,7 +69,7 @@ pub const WIRE_COLOR: Vec3 = Vec3::new(1.0, 0.75, 0.2);
 #[derive(Debug)]
 pub struct StandardFrame {
     pub renderer: Renderer,
-    pub cache: VertexCache<Vec3>,
+    pub cache: VertexCache<Direction>,
     /// Time of the last frame's vertex stage and of its raster stage (coverage, depth
     /// and shading are one fused loop, so they are timed together).
     pub timing: [std::time::Duration; 2],

@@ -25,7 +25,7 @@ use crate::raster::clip::{
 };
 use crate::raster::depth::{DepthBuffer, DepthFunc, DepthState};
 use crate::raster::interp::{
-    Interpolation, Varying, perspective_weights, projective_weights, span_lerp, span_position,
+    Interpolation, Varying, perspective_weights, span_lerp, span_position,
 };
 use crate::raster::setup::snap;
 use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup, Target, Traversal};
@@ -173,6 +173,10 @@ pub struct Prepared<V> {
     pub inv_w: [f32; 3],
     /// The varyings in relative form (see [`Varying::relative`]).
     pub rel: [V; 3],
+    /// For [`Varying::PROJECTIVE`] varyings, the vertex values times `pc`
+    /// ([`Varying::projective_form`]), interpolated with the edge values as weights
+    /// under perspective. Otherwise a copy of `rel`, never read.
+    pub proj: [V; 3],
     /// `1 / area2`, rounded once to f32: barycentrics are `F · inv_area2`.
     pub inv_area2: f32,
     /// Depth per unit of B's and C's edge value: `(z_B − z_A) / area2` and
@@ -226,16 +230,6 @@ fn depth_lanes<F: F32s>(q: [F; 3], z_a: f32, zc: &[f32; 2]) -> F {
         q[1].mul_add(F::splat(zc[0]), F::splat(z_a)),
     );
     F::splat(1.0).min(F::splat(0.0).max(d))
-}
-
-/// [`projective_weights`] on lanes.
-#[inline(always)]
-fn projective_weights_lanes<F: F32s>(q: [F; 3], pc: [f32; 3]) -> [F; 3] {
-    [
-        q[0] * F::splat(pc[0]),
-        q[1] * F::splat(pc[1]),
-        q[2] * F::splat(pc[2]),
-    ]
 }
 
 /// [`perspective_weights`] on lanes.
@@ -342,7 +336,6 @@ impl<V: Varying> Prepared<V> {
                 let (a, t) = span_position(e.x, n);
                 span_lerp(self.persp_at(a, e.y), self.persp_at(a + n, e.y), t)
             }
-            _ if V::PROJECTIVE => projective_weights(self.vertex_edges(e.f), self.pc),
             _ => e.persp,
         }
     }
@@ -351,7 +344,11 @@ impl<V: Varying> Prepared<V> {
     #[inline(always)]
     #[must_use]
     pub fn varyings(&self, e: &PixelEval, mode: Interpolation) -> V {
-        V::from_relative(&self.rel, self.weights(e, mode))
+        if V::PROJECTIVE && mode == Interpolation::Perspective {
+            V::from_relative(&self.proj, self.vertex_edges(e.f))
+        } else {
+            V::from_relative(&self.rel, self.weights(e, mode))
+        }
     }
 }
 
@@ -587,6 +584,8 @@ fn setup_piece<V: Varying>(
     let ia = 1.0 / setup.area2 as f64;
     let slope = |i: usize| ((f64::from(z[i]) - f64::from(z[0])) * ia) as f32;
     let zc = [slope(1), slope(2)];
+    let pc = each3!(|i| (f64::from(inv_w[i]) * ia) as f32);
+    let rel = V::relative(&var[0], &var[1], &var[2]);
     emit.piece(&Prepared {
         triangle: t,
         piece: piece as u8,
@@ -596,8 +595,13 @@ fn setup_piece<V: Varying>(
         z,
         inv_w,
         zc,
-        pc: each3!(|i| (f64::from(inv_w[i]) * ia) as f32),
-        rel: V::relative(&var[0], &var[1], &var[2]),
+        pc,
+        rel,
+        proj: if V::PROJECTIVE {
+            V::projective_form(&var, pc)
+        } else {
+            rel
+        },
         inv_area2: ia as f32,
         edge_rem,
     });
@@ -781,18 +785,21 @@ impl<S: Shader, C: ColorTarget, L: I32s, const STD: bool> Fragments<'_, S, C, L,
         if pass == 0 {
             return;
         }
-        let w = match interpolation {
-            Interpolation::Perspective if S::Varying::PROJECTIVE => {
-                projective_weights_lanes(q, t.pc)
-            }
-            Interpolation::Perspective => perspective_weights_lanes(q, t.pc),
+        // Projective varyings take the edge values themselves as weights (see
+        // `Prepared::varyings`).
+        let (rel, w) = match interpolation {
+            Interpolation::Perspective if S::Varying::PROJECTIVE => (&t.proj, q),
+            Interpolation::Perspective => (&t.rel, perspective_weights_lanes(q, t.pc)),
             Interpolation::Affine => {
                 let ia = F::splat(t.inv_area2);
-                [q[0] * ia, q[1] * ia, q[2] * ia]
+                (&t.rel, [q[0] * ia, q[1] * ia, q[2] * ia])
             }
-            mode => span_weights_lanes(t, mode.span().unwrap_or(8), x0, y),
+            mode => (
+                &t.rel,
+                span_weights_lanes(t, mode.span().unwrap_or(8), x0, y),
+            ),
         };
-        match self.shader.fragment_lanes(&t.rel, &w, pass) {
+        match self.shader.fragment_lanes(rel, &w, pass) {
             ShadeLanes::Rgb(c) => self.color.put_lanes(start, stride, pass, &c),
             ShadeLanes::Grey(g) => self.color.put_lanes_grey(start, stride, pass, g),
         }

@@ -18,11 +18,13 @@ use glam::{Vec2, Vec3, Vec4};
 pub trait Varying: Copy {
     /// Whether only the value's direction matters to the shader that reads it (a
     /// normal it normalises per pixel): the value times any positive factor shades
-    /// the same. Such a varying is interpolated under perspective as `attribute/w`
+    /// the same. Under perspective such a varying is interpolated as `attribute/w`
     /// itself, eq. 21's numerator `Σ vᵢ·bᵢ/wᵢ`, without eq. 23's division by the
-    /// interpolated `1/w`, which saves a division per pixel: it receives weights that
-    /// sum to the interpolated `1/w` rather than to 1 (see [`projective_weights`]).
-    /// Its relative form is then the vertex values themselves (see [`Direction`]).
+    /// interpolated `1/w`: as `Σ (vᵢ·cᵢ)·Fᵢ` for the exact edge values `Fᵢ`, with
+    /// `cᵢ = (1/wᵢ)/area2` folded into the vertex values once per triangle
+    /// ([`Varying::projective_form`]). That saves a division and a multiply per
+    /// vertex per pixel. In the other modes it is a weighted sum of the vertex values
+    /// (its relative form is `[a, b, c]`: see [`Direction`]).
     const PROJECTIVE: bool = false;
 
     /// The interpolated value for weights `w` (summing to 1), computed relative to `a`
@@ -37,6 +39,14 @@ pub trait Varying: Copy {
     /// per triangle instead of once per pixel. ([`Varying::PROJECTIVE`] varyings keep
     /// `[a, b, c]`.)
     fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3];
+
+    /// The per-triangle form of a [`Varying::PROJECTIVE`] varying under perspective:
+    /// the vertex values `v` times `c` (see there). Other varyings never use it.
+    #[must_use]
+    fn projective_form(v: &[Self; 3], c: [f32; 3]) -> [Self; 3] {
+        let _ = c;
+        *v
+    }
 
     /// `r[0] + r[1]·w[1] + r[2]·w[2]` (as two fused multiply-adds, inner first) for `r`
     /// from [`Varying::relative`]: exactly [`Varying::weighted`] of the vertices `r`
@@ -96,7 +106,7 @@ vector_varying!(f32, Vec2, Vec3, Vec4);
 /// A direction that its shader normalises per pixel (Lambert's normal): a
 /// [`Varying::PROJECTIVE`] varying, interpolated as `Σ vᵢ·bᵢ/wᵢ` (a positive multiple
 /// of the perspective-correct value) in the default perspective mode, and as an
-/// ordinary weighted sum, from the vertex values, in the others.
+/// ordinary weighted sum of the vertex values in the others.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Direction(pub Vec3);
 
@@ -106,6 +116,14 @@ impl Varying for Direction {
     fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3] {
         // Weights that need not sum to 1 leave nothing to take relative to a vertex.
         [*a, *b, *c]
+    }
+    #[inline(always)]
+    fn projective_form(v: &[Self; 3], c: [f32; 3]) -> [Self; 3] {
+        [
+            Self(v[0].0 * c[0]),
+            Self(v[1].0 * c[1]),
+            Self(v[2].0 * c[2]),
+        ]
     }
     #[inline(always)]
     fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
@@ -228,24 +246,15 @@ pub fn span_lerp(wa: [f32; 3], wb: [f32; 3], t: f32) -> [f32; 3] {
     ]
 }
 
-/// The numerators of eq. 23 from the edge values `q` weighing each vertex and
-/// `c[i] = (1/w_i) / area2`: `p_i = q_i·c_i` is `b_i/w_i`, and `Σ p_i` the
-/// interpolated `1/w`. The weights of [`Varying::PROJECTIVE`] varyings.
-#[must_use]
-#[inline(always)]
-pub fn projective_weights(q: [f32; 3], c: [f32; 3]) -> [f32; 3] {
-    [q[0] * c[0], q[1] * c[1], q[2] * c[2]]
-}
-
 /// Perspective-correct weights (eq. 23) from the edge values `q` weighing each vertex
-/// and `c[i] = (1/w_i) / area2`, plus the interpolated `1/w` itself: the weights are
-/// `p_i / Σ p_j` for `p` from [`projective_weights`]. The sum is of non-negative
-/// terms inside the triangle, so it never cancels.
+/// and `c[i] = (1/w_i) / area2`, plus the interpolated `1/w` itself: `p_i = q_i·c_i`
+/// is `b_i/w_i`, and the weights are `p_i / Σ p_j`. The sum is of non-negative terms
+/// inside the triangle, so it never cancels.
 #[must_use]
 #[inline(always)]
 pub fn perspective_weights(q: [f32; 3], c: [f32; 3]) -> ([f32; 3], f32) {
     // Same operations, same order, as the renderer's 8-lane path.
-    let p = projective_weights(q, c);
+    let p = [q[0] * c[0], q[1] * c[1], q[2] * c[2]];
     let s = q[2].mul_add(c[2], q[1].mul_add(c[1], p[0]));
     let r = 1.0 / s;
     ([p[0] * r, p[1] * r, p[2] * r], s)

@@ -155,7 +155,7 @@ mod tests {
 
     use super::Lambert;
     use crate::mesh::Mesh;
-    use crate::raster::interp::{Direction, Varying, perspective_weights, projective_weights};
+    use crate::raster::interp::{Direction, Varying, perspective_weights};
     use crate::render::{ShadeLanes, Shader};
     use crate::simd::F32s;
 
@@ -186,8 +186,8 @@ mod tests {
             let q = [q.0, q.1, q.2];
             let (persp, _) = perspective_weights(q, c);
             let exact = shader.fragment(&Direction(Vec3::weighted(&n[0], &n[1], &n[2], persp)));
-            let d = n.map(Direction);
-            let fast = shader.fragment(&Direction::weighted(&d[0], &d[1], &d[2], projective_weights(q, c)));
+            let proj = Direction::projective_form(&n.map(Direction), c);
+            let fast = shader.fragment(&Direction::from_relative(&proj, q));
             let err = (exact - fast).abs().max_element();
             prop_assert!(err <= 2e-6, "{exact} against {fast}");
         }

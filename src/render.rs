@@ -326,7 +326,9 @@ impl<V: Varying> Prepared<V> {
         self.eval(x, y).persp
     }
 
-    /// The interpolation weights of A, B, C at an evaluated pixel in `mode`.
+    /// The interpolation weights of A, B, C at an evaluated pixel in `mode`, summing
+    /// to 1. ([`Prepared::varyings`] weighs a projective varying's `proj` by the edge
+    /// values instead under perspective.)
     #[inline(always)]
     #[must_use]
     pub fn weights(&self, e: &PixelEval, mode: Interpolation) -> [f32; 3] {

@@ -36,7 +36,8 @@ pub struct ProbeRecord<V> {
     pub depth: DepthOutcome,
     /// Classification of the pixel's block by the `block` traversal (q = 8).
     pub block: BlockClass,
-    /// Interpolated varyings (for the shading value).
+    /// Interpolated varyings as the shader receives them (for the shading value): for
+    /// a [`Varying::PROJECTIVE`] varying under perspective, `attribute/w`.
     pub varying: V,
 }
 

@@ -41,7 +41,8 @@ pub trait Varying: Copy {
     fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3];
 
     /// The per-triangle form of a [`Varying::PROJECTIVE`] varying under perspective:
-    /// the vertex values `v` times `c` (see there). Other varyings never use it.
+    /// the vertex values `v` times `c` (see there). Other varyings never read it, and
+    /// keep the vertex values.
     #[must_use]
     fn projective_form(v: &[Self; 3], c: [f32; 3]) -> [Self; 3] {
         let _ = c;

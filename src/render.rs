@@ -566,7 +566,7 @@ fn setup_piece<V: Varying>(
     if !(proj[0].snapped && proj[1].snapped && proj[2].snapped) {
         return Piece::Rejected;
     }
-    let Ok(setup) = Setup::from_fixed(each3!(|i| proj[i].fixed), target) else {
+    let Ok(setup) = Setup::from_snapped(each3!(|i| proj[i].fixed), target) else {
         return Piece::Rejected;
     };
     // Counter-clockwise in NDC (y-up) is negative area in y-down screen space.
@@ -575,10 +575,10 @@ fn setup_piece<V: Varying>(
     }
     let order = |i: usize| if setup.flipped && i > 0 { 3 - i } else { i };
     let var = each3!(|i| var[order(i)]);
-    let (ox, oy) = (i64::from(setup.bbox.x0), i64::from(setup.bbox.y0));
+    // The raw value at the box's origin less 256 times the reduced one.
     let edge_rem = each3!(|e| {
-        let g = setup.reduced_edge(e, ox, oy);
-        (setup.edge_raw(e, ox, oy) - (g << SUBPIXEL_BITS)) as f32
+        let f = setup.origin[e];
+        (f - setup.bias[e] - (f >> SUBPIXEL_BITS << SUBPIXEL_BITS)) as f32
     });
     let z = each3!(|i| proj[order(i)].z);
     let inv_w = each3!(|i| proj[order(i)].inv_w);

@@ -3,6 +3,8 @@
 //! Everything here is computed once per triangle and shared by every traversal, the
 //! probe and the 3D pipeline, so they cannot disagree about which pixels are covered.
 
+use crate::simd::each3;
+
 /// Fractional bits of the vertex grid: vertices snap to 1/256 px.
 pub const SUBPIXEL_BITS: u32 = 8;
 /// One pixel in subpixel units.
@@ -141,6 +143,10 @@ pub struct Setup {
     pub area2: i64,
     /// Pixels whose centres lie in the triangle's bounding box, clipped to the target.
     pub bbox: PixelRect,
+    /// Biased `F0e` at the centre of the box's first pixel `(x0, y0)`: where every
+    /// traversal starts, computed once because the set-up record, the range checks and
+    /// the traversals all start from it.
+    pub origin: [i64; 3],
 }
 
 impl Setup {
@@ -155,18 +161,25 @@ impl Setup {
                 *c = snap(x).ok_or(Reject::BeyondGuardBand)?;
             }
         }
-        Self::from_fixed(v, target)
+        Self::from_snapped(v, target)
     }
 
-    /// Sets up a triangle whose vertices are already on the subpixel grid. Inlined so
-    /// the renderer builds the setup in place in its per-triangle record.
+    /// Sets up a triangle whose vertices are already on the subpixel grid.
     #[inline(always)]
-    pub fn from_fixed(mut v: [[i64; 2]; 3], target: Target) -> Result<Self, Reject> {
-        let limit = (GUARD_BAND_PX as i64) * SUBPIXEL_ONE;
-        let far = |p: [i64; 2]| p[0].abs() > limit || p[1].abs() > limit;
-        if far(v[0]) || far(v[1]) || far(v[2]) {
+    pub fn from_fixed(v: [[i64; 2]; 3], target: Target) -> Result<Self, Reject> {
+        if !v.iter().flatten().all(|&c| in_band(c)) {
             return Err(Reject::BeyondGuardBand);
         }
+        Self::from_snapped(v, target)
+    }
+
+    /// [`Setup::from_fixed`] for vertices that [`snap`] gave, and so lie within the
+    /// guard band (which keeps every product below in `i64`): the renderer's vertices
+    /// are all checked once when projected, not again for each triangle. Inlined so the
+    /// renderer builds the setup in place in its per-triangle record.
+    #[inline(always)]
+    pub(crate) fn from_snapped(mut v: [[i64; 2]; 3], target: Target) -> Result<Self, Reject> {
+        debug_assert!(v.iter().flatten().all(|&c| in_band(c)), "{v:?}");
         // The box first: at terminal resolutions many triangles hold no pixel centre.
         let bbox = pixel_bounds(&v, target).ok_or(Reject::Offscreen)?;
         let [a, b, c] = v;
@@ -194,6 +207,9 @@ impl Setup {
             let top = b[1] == a[1] && b[0] > a[0];
             bias[e] = if left || top { 0 } else { -1 };
         }
+        let px = i64::from(bbox.x0) * SUBPIXEL_ONE + HALF_PIXEL;
+        let py = i64::from(bbox.y0) * SUBPIXEL_ONE + HALF_PIXEL;
+        let origin = each3!(|e| i[e] * px + j[e] * py + k[e] + bias[e]);
 
         Ok(Self {
             v,
@@ -204,6 +220,7 @@ impl Setup {
             bias,
             area2,
             bbox,
+            origin,
         })
     }
 
@@ -292,6 +309,12 @@ impl Setup {
     pub fn unflip<T: Copy>(&self, b: [T; 3]) -> [T; 3] {
         if self.flipped { [b[0], b[2], b[1]] } else { b }
     }
+}
+
+/// Whether a coordinate in subpixels lies within the guard band (as every one [`snap`]
+/// returns does).
+fn in_band(c: i64) -> bool {
+    c.abs() <= (GUARD_BAND_PX as i64) * SUBPIXEL_ONE
 }
 
 /// Pixels whose centres lie within the vertices' bounding box, clipped to the target.

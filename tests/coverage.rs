@@ -160,6 +160,39 @@ proptest! {
         assert_all_match_oracle([a, c, b], T);
     }
 
+    /// `Setup::from_fixed` on subpixel vertices anywhere near the guard band: rejects
+    /// exactly the triangles with a coordinate beyond it, and otherwise starts every
+    /// walk (`Setup::origin`) from the edge functions of its own vertices at the box's
+    /// first pixel centre, evaluated in i128 with the fill rule's bias.
+    #[test]
+    fn setup_origin_is_the_edge_functions_at_the_first_pixel(
+        v in prop::array::uniform6(prop_oneof![
+            -3000i64..30000,
+            -(1i64 << 28) - 2..=-(1i64 << 28) + 2,
+            (1i64 << 28) - 2..=(1i64 << 28) + 2,
+            any::<i32>().prop_map(i64::from),
+        ]),
+    ) {
+        let limit = (termrast::raster::GUARD_BAND_PX as i64) << 8;
+        let fixed = [[v[0], v[1]], [v[2], v[3]], [v[4], v[5]]];
+        match Setup::from_fixed(fixed, T) {
+            Err(e) => {
+                let beyond = v.iter().any(|c| c.abs() > limit);
+                prop_assert_eq!(e == termrast::raster::Reject::BeyondGuardBand, beyond);
+            }
+            Ok(s) => {
+                prop_assert!(v.iter().all(|c| c.abs() <= limit));
+                let centre = |p: u32| i128::from(p) * 256 + 128;
+                let (px, py) = (centre(s.bbox.x0), centre(s.bbox.y0));
+                for e in 0..3 {
+                    let (a, b) = (s.v[e].map(i128::from), s.v[(e + 1) % 3].map(i128::from));
+                    let f = (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0]);
+                    prop_assert_eq!(i128::from(s.origin[e]), f + i128::from(s.bias[e]), "edge {}", e);
+                }
+            }
+        }
+    }
+
     /// Arbitrary bit patterns: never a panic, never a pixel outside the target or bbox,
     /// and the same answer as the oracle (which also rejects NaN, inf and huge values).
     #[test]

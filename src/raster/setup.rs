@@ -164,7 +164,8 @@ impl Setup {
         Self::from_snapped(v, target)
     }
 
-    /// Sets up a triangle whose vertices are already on the subpixel grid.
+    /// Sets up a triangle whose vertices are already on the subpixel grid, rejecting
+    /// any coordinate beyond the guard band (whose bound keeps set-up within `i64`).
     #[inline(always)]
     pub fn from_fixed(v: [[i64; 2]; 3], target: Target) -> Result<Self, Reject> {
         if !v.iter().flatten().all(|&c| in_band(c)) {

@@ -576,10 +576,8 @@ fn setup_piece<V: Varying>(
     let order = |i: usize| if setup.flipped && i > 0 { 3 - i } else { i };
     let var = each3!(|i| var[order(i)]);
     // The raw value at the box's origin less 256 times the reduced one.
-    let edge_rem = each3!(|e| {
-        let f = setup.origin[e];
-        (f - setup.bias[e] - (f >> SUBPIXEL_BITS << SUBPIXEL_BITS)) as f32
-    });
+    let g = setup.reduced_at_origin();
+    let edge_rem = each3!(|e| (setup.origin[e] - setup.bias[e] - (g[e] << SUBPIXEL_BITS)) as f32);
     let z = each3!(|i| proj[order(i)].z);
     let inv_w = each3!(|i| proj[order(i)].inv_w);
     // In f64, rounded once: the per-pixel terms then carry one rounding each.

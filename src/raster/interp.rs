@@ -137,7 +137,7 @@ impl Varying for Direction {
     }
     #[inline(always)]
     fn lerp(a: &Self, b: &Self, t: f32) -> Self {
-        Self(a.0 + (b.0 - a.0) * t)
+        Self(<Vec3 as Varying>::lerp(&a.0, &b.0, t))
     }
 }
 

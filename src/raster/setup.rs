@@ -296,11 +296,19 @@ impl Setup {
         self.j.map(|j| j * SUBPIXEL_ONE)
     }
 
-    /// The edge values at the bbox origin, the first value every traversal starts from.
+    /// The edge values at the bbox origin, the first value every traversal starts from
+    /// ([`Setup::origin`]).
     #[must_use]
     #[inline]
     pub fn edges_at_origin(&self) -> [i64; 3] {
-        self.edges(self.bbox.x0.into(), self.bbox.y0.into())
+        self.origin
+    }
+
+    /// [`Setup::reduced_edge`] at the bbox origin: where the `wide` traversal starts.
+    #[must_use]
+    #[inline(always)]
+    pub fn reduced_at_origin(&self) -> [i64; 3] {
+        each3!(|e| self.origin[e] >> SUBPIXEL_BITS)
     }
 
     /// Maps a barycentric triple in setup order (A, B, C after any flip) back to the

@@ -1,6 +1,6 @@
 use wide::{i32x8, i64x4};
 
-use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup};
+use crate::raster::{CoverageSink, Setup};
 use crate::simd::{I32s, each3};
 
 /// Edge values of a group: 8 lanes per row of pixels, [`Lanes::ROWS`] rows.
@@ -90,7 +90,7 @@ impl Lanes for Lanes64 {
 /// triangles up to a few thousand pixels within `i32`.
 #[inline(always)]
 fn reduced(s: &Setup) -> ([i64; 3], [i64; 3], [i64; 3]) {
-    (each3!(|e| s.origin[e] >> SUBPIXEL_BITS), s.i, s.j)
+    (s.reduced_at_origin(), s.i, s.j)
 }
 
 /// Whether every value the `wide` traversal forms for this setup fits in `i32`: the

@@ -34,7 +34,32 @@ impl Default for Camera {
     }
 }
 
+/// How much of the narrower half of the view a framed model's bounding sphere spans.
+pub const FRAME_FILL: f32 = 0.88;
+
 impl Camera {
+    /// The standard camera moved along +z until a sphere of `radius` about the origin
+    /// spans [`FRAME_FILL`] of the view's narrower half, for a view `aspect` times as
+    /// wide as it is tall: seen from distance `d` the sphere's outline is a circle of
+    /// tangent `r / √(d² − r²)`, which is set to `FRAME_FILL · tan(fov/2)` on the narrower
+    /// side. Near and far planes follow the distance so zooming out never clips.
+    #[must_use]
+    pub fn framing(radius: f32, aspect: f32, zoom: f32) -> Self {
+        let mut c = Self::default();
+        let r = if radius.is_finite() && radius > 0.0 {
+            radius
+        } else {
+            1.0
+        };
+        let half = (c.fov_y * 0.5).tan() * aspect.clamp(1e-3, 1.0);
+        let t = FRAME_FILL * half;
+        let d = r * (1.0 + 1.0 / (t * t)).sqrt() / zoom.max(0.05);
+        c.eye = Vec3::new(0.0, 0.0, d);
+        c.near = (d - 2.0 * r).max(0.01 * d).min(c.near);
+        c.far = c.far.max(d + 2.0 * r);
+        c
+    }
+
     /// World to view space.
     #[must_use]
     pub fn view(&self) -> Mat4 {

@@ -193,6 +193,17 @@ impl Mesh {
         }
     }
 
+    /// The radius of the smallest sphere about the origin that holds every vertex
+    /// (unchanged by any rotation about the origin, so a spinning model stays inside it).
+    #[must_use]
+    pub fn bounding_radius(&self) -> f32 {
+        self.positions
+            .iter()
+            .map(|p| p.length())
+            .filter(|l| l.is_finite())
+            .fold(0.0, f32::max)
+    }
+
     /// Generates smooth per-vertex normals (area-weighted face normals) if there are
     /// none. Degenerate neighbourhoods fall back to +z rather than NaN.
     pub fn ensure_normals(&mut self) {

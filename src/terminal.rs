@@ -7,6 +7,7 @@
 
 pub mod color;
 pub mod glyphs;
+pub mod shapes;
 
 pub use color::{ColorMode, Rgb};
 pub use glyphs::{CellGlyph, GlyphMode};

@@ -140,9 +140,10 @@ pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
     let target = args.size;
     let mut frame = StandardFrame::new(target);
     let mut color = Rgba8::default();
+    let aspect = target.width as f32 / target.height as f32;
     frame.draw(
         &model,
-        &StandardView::at(args.angle),
+        &StandardView::framed(&model, aspect, 1.0, args.angle),
         target,
         &args.scene.options(),
         args.scene.mode,

@@ -34,7 +34,8 @@ pub struct StandardView {
 }
 
 impl StandardView {
-    /// The standard camera, model turned by `angle`, square pixels.
+    /// The standard camera, model turned by `angle`, square pixels: the benchmark's
+    /// fixed view, whatever the model's size or the target's aspect.
     #[must_use]
     pub fn at(angle: f32) -> Self {
         Self {
@@ -44,6 +45,16 @@ impl StandardView {
             pixel_aspect: 1.0,
         }
     }
+
+    /// The view of `model` that frames its bounding sphere (see [`Camera::framing`])
+    /// in a view `aspect` times as wide as it is tall, moved closer by `zoom`.
+    #[must_use]
+    pub fn framed(model: &Model, aspect: f32, zoom: f32, angle: f32) -> Self {
+        Self {
+            camera: Camera::framing(model.radius, aspect, zoom),
+            ..Self::at(angle)
+        }
+    }
 }
 
 /// A mesh with its unique edges (for wireframes), computed once.
@@ -51,14 +62,21 @@ impl StandardView {
 pub struct Model {
     pub mesh: Mesh,
     pub edges: Vec<[u32; 2]>,
+    /// [`Mesh::bounding_radius`], for framing.
+    pub radius: f32,
 }
 
 impl Model {
-    /// Computes the edges of a mesh.
+    /// Computes the edges and bounding radius of a mesh.
     #[must_use]
     pub fn new(mesh: Mesh) -> Self {
         let edges = unique_edges(&mesh.indices);
-        Self { mesh, edges }
+        let radius = mesh.bounding_radius();
+        Self {
+            mesh,
+            edges,
+            radius,
+        }
     }
 }
 

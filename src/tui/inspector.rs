@@ -55,7 +55,7 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
     };
     let opts = vp.settings.options();
     let indices = &model.mesh.indices;
-    let view = vp.settings.view();
+    let view = vp.view;
     let shader = StandardFrame::shader(&model.mesh, &view, vp.target);
     let _ = writeln!(t, "samples ({} per cell):", n);
     // The selected sample's probe is kept for the overdraw list below.

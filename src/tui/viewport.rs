@@ -48,13 +48,14 @@ impl Default for ViewSettings {
 }
 
 impl ViewSettings {
-    /// The camera and model rotation for this frame, for a glyph mode's samples.
+    /// The camera and model rotation for a `cols × rows` cell view of `model`, for a
+    /// glyph mode's samples: the model's bounding sphere framed at zoom 1.
     #[must_use]
-    pub fn view(&self) -> StandardView {
+    pub fn view(&self, model: &Model, cols: u16, rows: u16) -> StandardView {
         let (sx, sy) = self.glyphs.dims();
-        let mut v = StandardView::at(self.angle);
+        let aspect = f32::from(cols.max(1)) * self.cell_aspect / f32::from(rows.max(1));
+        let mut v = StandardView::framed(model, aspect, self.zoom, self.angle);
         v.tilt = self.tilt;
-        v.camera.eye.z /= self.zoom.max(0.05);
         v.pixel_aspect = self.cell_aspect * sy as f32 / sx as f32;
         v
     }
@@ -81,6 +82,8 @@ pub struct Viewport {
     /// Sample target of the last frame.
     pub target: Target,
     pub settings: ViewSettings,
+    /// The camera of the last model frame (the probe must see what was drawn).
+    pub view: StandardView,
     /// Time spent fitting glyphs.
     pub glyph_time: Duration,
     pub wire_pixels: u64,
@@ -96,6 +99,7 @@ impl Default for Viewport {
             rows: 0,
             target: Target::new(1, 1),
             settings: ViewSettings::default(),
+            view: StandardView::at(0.0),
             glyph_time: Duration::ZERO,
             wire_pixels: 0,
         }
@@ -106,10 +110,10 @@ impl Viewport {
     /// Renders the model for a `cols × rows` cell area and fits every cell's glyph.
     pub fn render(&mut self, model: &Model, settings: &ViewSettings, cols: u16, rows: u16) {
         let target = self.lay_out(settings, cols, rows);
-        let view = settings.view();
+        self.view = settings.view(model, cols, rows);
         self.wire_pixels = self.frame.draw(
             model,
-            &view,
+            &self.view,
             target,
             &settings.options(),
             settings.mode,

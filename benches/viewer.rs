@@ -1,6 +1,6 @@
 //! Whole viewer frames (`cargo bench --bench viewer`): transform, raster, glyph
 //! fitting, ratatui's diff and the write to a byte-counting sink, at 200×60 cells in
-//! braille mode, the model turning between frames as it does in the viewer.
+//! braille and blocks modes, the model turning between frames as it does in the viewer.
 
 use std::cell::Cell;
 use std::io;
@@ -16,11 +16,17 @@ use termrast::tui::app::App;
 use termrast::tui::viewport::ViewSettings;
 
 fn bench(c: &mut Criterion) {
-    let mut g = c.benchmark_group("viewer-frame-200x60-braille");
+    let mut g = c.benchmark_group("viewer-frame-200x60");
     for (name, spec) in [("teapot", "teapot"), ("bunny", "bunny")] {
-        for colors in [ColorMode::Truecolor, ColorMode::Ansi256] {
+        for (glyphs, colors) in [
+            (GlyphMode::Braille, ColorMode::Truecolor),
+            (GlyphMode::Braille, ColorMode::Ansi256),
+            (GlyphMode::Blocks, ColorMode::Truecolor),
+            (GlyphMode::Blocks, ColorMode::Ansi256),
+            (GlyphMode::Ascii, ColorMode::Truecolor),
+        ] {
             let settings = ViewSettings {
-                glyphs: GlyphMode::Braille,
+                glyphs,
                 colors,
                 ..ViewSettings::default()
             };
@@ -39,7 +45,8 @@ fn bench(c: &mut Criterion) {
             .expect("terminal");
             let frame = std::time::Duration::from_millis(33);
             let mut frames = 0u64;
-            g.bench_function(BenchmarkId::new(name, colors.name()), |b| {
+            let id = format!("{}-{}", glyphs.name(), colors.name());
+            g.bench_function(BenchmarkId::new(name, &id), |b| {
                 b.iter(|| {
                     app.tick(frame);
                     term.draw(|f| app.draw(f)).expect("draw");
@@ -47,8 +54,7 @@ fn bench(c: &mut Criterion) {
                 });
             });
             eprintln!(
-                "{name} {}: {} bytes per frame",
-                colors.name(),
+                "{name} {id}: {} bytes per frame",
                 bytes.get() / frames.max(1)
             );
         }

@@ -39,20 +39,19 @@ pub const FRAME_FILL: f32 = 0.88;
 
 impl Camera {
     /// The standard camera moved along +z until a sphere of `radius` about the origin
-    /// spans [`FRAME_FILL`] of the view's narrower half, for a view `aspect` times as
-    /// wide as it is tall: seen from distance `d` the sphere's outline is a circle of
-    /// tangent `r / √(d² − r²)`, which is set to `FRAME_FILL · tan(fov/2)` on the narrower
-    /// side. Near and far planes follow the distance so zooming out never clips.
+    /// spans [`FRAME_FILL`] of the view's narrower half (whose field of view is `fov_y`,
+    /// see [`Camera::projection`]), moved closer by `zoom`: seen from distance `d` the
+    /// sphere's outline is a circle of tangent `r / √(d² − r²)`. Near and far planes
+    /// follow the distance so zooming out never clips.
     #[must_use]
-    pub fn framing(radius: f32, aspect: f32, zoom: f32) -> Self {
+    pub fn framing(radius: f32, zoom: f32) -> Self {
         let mut c = Self::default();
         let r = if radius.is_finite() && radius > 0.0 {
             radius
         } else {
             1.0
         };
-        let half = (c.fov_y * 0.5).tan() * aspect.clamp(1e-3, 1.0);
-        let t = FRAME_FILL * half;
+        let t = FRAME_FILL * (c.fov_y * 0.5).tan();
         let d = r * (1.0 + 1.0 / (t * t)).sqrt() / zoom.max(0.05);
         c.eye = Vec3::new(0.0, 0.0, d);
         c.near = (d - 2.0 * r).max(0.01 * d).min(c.near);
@@ -68,10 +67,16 @@ impl Camera {
 
     /// View to clip space for a `width × height` pixel target whose pixels are
     /// `pixel_aspect` times as wide as they are tall (1 for square pixels, 0.5 for a
-    /// terminal cell sampled once).
+    /// terminal cell sampled once). `fov_y` spans the narrower side: the height of a
+    /// wide view, the width of a tall one, so what fits one aspect fits every other.
     #[must_use]
     pub fn projection(&self, width: u32, height: u32, pixel_aspect: f32) -> Mat4 {
         let aspect = (width.max(1) as f32 * pixel_aspect) / height.max(1) as f32;
-        glam::camera::rh::proj::directx::perspective(self.fov_y, aspect, self.near, self.far)
+        let fov = if aspect < 1.0 {
+            2.0 * ((self.fov_y * 0.5).tan() / aspect).atan()
+        } else {
+            self.fov_y
+        };
+        glam::camera::rh::proj::directx::perspective(fov, aspect, self.near, self.far)
     }
 }

@@ -234,15 +234,14 @@ impl Scene {
     /// Loads a scene from its text; `path` names it and anchors relative paths.
     pub fn from_text(text: &str, path: &Path) -> Result<Self, SceneError> {
         let f = file::parse(text, path)?;
-        let c = &f.camera;
-        let camera = Camera {
+        let camera = f.camera.as_ref().map(|c| Camera {
             eye: Vec3::from(c.eye),
             target: Vec3::from(c.target),
             up: Vec3::from(c.up),
             fov_y: c.fov.to_radians(),
             near: c.near,
             far: c.far,
-        };
+        });
         let mut lights: Vec<LightDesc> = f
             .lights
             .iter()
@@ -292,6 +291,7 @@ impl Scene {
             .enumerate()
             .map(|(i, (desc, op))| load_object(desc, op, path, i + 1))
             .collect::<Result<Vec<_>, _>>()?;
+        let camera = camera.unwrap_or_else(|| framing(&objects));
         Ok(Self {
             source: path.display().to_string(),
             camera,
@@ -301,6 +301,32 @@ impl Scene {
             plan,
         })
     }
+}
+
+/// The camera for a scene without one: looking down −z at the centre of a sphere that
+/// holds every object however it spins, framed by [`Camera::framing`].
+fn framing(objects: &[SceneObject]) -> Camera {
+    let spheres: Vec<(Vec3, f32)> = objects
+        .iter()
+        .map(|o| (o.desc.position, o.mesh.bounding_radius() * o.desc.scale))
+        .collect();
+    let (lo, hi) = spheres.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &(c, r)| (lo.min(c - r), hi.max(c + r)),
+    );
+    let centre = if lo.is_finite() && hi.is_finite() {
+        (lo + hi) * 0.5
+    } else {
+        Vec3::ZERO
+    };
+    let radius = spheres
+        .iter()
+        .map(|&(c, r)| (c - centre).length() + r)
+        .fold(0.0, f32::max);
+    let mut camera = Camera::framing(radius, 1.0);
+    camera.target += centre;
+    camera.eye += centre;
+    camera
 }
 
 /// Loads an object's model and keeps, derives and drops exactly what its plan says.

@@ -6,7 +6,9 @@
 //! 0.5), so a sample's aspect is `cell_aspect · sy / sx`.
 
 pub mod color;
+pub mod fit;
 pub mod glyphs;
+pub mod locale;
 pub mod shapes;
 
 pub use color::{ColorMode, Rgb};

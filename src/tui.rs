@@ -56,6 +56,8 @@ pub enum ViewError {
          `termrast render [MODEL] --out frame.png`"
     )]
     NotATerminal,
+    #[error("{0}")]
+    Unsupported(String),
     #[error("terminal: {0}")]
     Io(#[from] io::Error),
 }

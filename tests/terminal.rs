@@ -23,15 +23,18 @@ fn half_block_uses_top_as_foreground() {
     let g = fit_cell(
         GlyphMode::Half,
         &[s([200, 10, 10]), s([10, 10, 200])],
-        false,
+        ColorMode::Truecolor,
     );
     assert_eq!(
         (g.ch, g.fg, g.bg),
         ('▀', Some([200, 10, 10]), Some([10, 10, 200]))
     );
-    let g = fit_cell(GlyphMode::Half, &[OFF, s([9, 9, 9])], false);
+    let g = fit_cell(GlyphMode::Half, &[OFF, s([9, 9, 9])], ColorMode::Truecolor);
     assert_eq!((g.ch, g.fg, g.bg), ('▄', Some([9, 9, 9]), None));
-    assert_eq!(fit_cell(GlyphMode::Half, &[OFF, OFF], false).ch, ' ');
+    assert_eq!(
+        fit_cell(GlyphMode::Half, &[OFF, OFF], ColorMode::Truecolor).ch,
+        ' '
+    );
 }
 
 #[test]
@@ -39,16 +42,21 @@ fn quadrant_fit_picks_the_bright_half() {
     // Top half bright, bottom half dark → upper half block, two colours.
     let w = s([250, 250, 250]);
     let d = s([20, 20, 20]);
-    let g = fit_cell(GlyphMode::Quadrant, &[w, w, d, d], false);
+    let g = fit_cell(GlyphMode::Quadrant, &[w, w, d, d], ColorMode::Truecolor);
     assert_eq!(
         (g.ch, g.fg, g.bg, g.error),
-        ('▀', Some([250; 3]), Some([20; 3]), 0)
+        ('▀', Some([250; 3]), Some([20; 3]), 0.0)
     );
     // One covered corner on an empty background.
-    let g = fit_cell(GlyphMode::Quadrant, &[OFF, OFF, OFF, w], false);
+    let g = fit_cell(
+        GlyphMode::Quadrant,
+        &[OFF, OFF, OFF, w],
+        ColorMode::Truecolor,
+    );
     assert_eq!((g.ch, g.bg), ('▗', None));
-    let g = fit_cell(GlyphMode::Quadrant, &[w, w, w, w], false);
-    assert_eq!(g.ch, '█');
+    // One colour is a space on that background.
+    let g = fit_cell(GlyphMode::Quadrant, &[w, w, w, w], ColorMode::Truecolor);
+    assert_eq!((g.ch, g.bg), (' ', Some([250; 3])));
 }
 
 #[test]
@@ -75,15 +83,21 @@ fn braille_and_sextant_bit_layouts() {
 #[test]
 fn colorless_modes_dither_by_luminance() {
     let grey = |v: u8| s([v, v, v]);
-    let dots = |v| {
-        fit_cell(GlyphMode::Braille, &[grey(v); 8], true)
-            .pattern
-            .count_ones()
+    // Uniform cells are shades: no braille dots over the default background.
+    let uniform = |v| fit_cell(GlyphMode::Braille, &[grey(v); 8], ColorMode::None).ch;
+    assert_eq!(uniform(0), ' ');
+    assert_eq!(uniform(128), '▒');
+    assert_eq!(uniform(255), '█');
+    // Other cells dither: more dots for brighter samples.
+    let dots = |v: u8| {
+        let mut c = [grey(v); 8];
+        c[0] = grey(v.saturating_sub(1));
+        let g = fit_cell(GlyphMode::Braille, &c, ColorMode::None);
+        assert_eq!((g.fg, g.bg), (None, None));
+        g.pattern.count_ones()
     };
-    assert_eq!(dots(0), 0);
-    assert_eq!(dots(255), 8);
+    assert_eq!(dots(1), 0);
     assert!(dots(64) < dots(128) && dots(128) < dots(200));
-    assert_eq!(fit_cell(GlyphMode::Braille, &[grey(255); 8], true).fg, None);
 }
 
 #[test]
@@ -255,13 +269,22 @@ mod fit_property {
                 if s.iter().all(|x| !x.covered) {
                     continue;
                 }
-                let g = fit_cell(mode, s, false);
+                let g = fit_cell(mode, s, ColorMode::Truecolor);
                 // Integer error with the mean's remainder truncated: within n of exact.
                 let want = best_error(s);
                 prop_assert!((f64::from(g.error) - want).abs() <= n as f64 + 1e-6, "{} vs {}", g.error, want);
-                // Foreground samples are covered ones; the glyph shows exactly them.
-                prop_assert!((0..n).all(|i| g.pattern >> i & 1 == 0 || s[i].covered));
+                if g.ch == ' ' {
+                    prop_assert!(g.bg.is_some() && g.fg.is_none());
+                    continue;
+                }
                 prop_assert_eq!(g.ch, mode.pattern_glyph(g.pattern));
+                if mode == GlyphMode::Braille {
+                    // The dots are on the smaller group.
+                    prop_assert!(g.pattern.count_ones() <= 4, "{}", g.pattern.count_ones());
+                } else {
+                    // Foreground samples are covered ones.
+                    prop_assert!((0..n).all(|i| g.pattern >> i & 1 == 0 || s[i].covered));
+                }
             }
         }
     }

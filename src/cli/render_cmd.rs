@@ -140,10 +140,9 @@ pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
     let target = args.size;
     let mut frame = StandardFrame::new(target);
     let mut color = Rgba8::default();
-    let aspect = target.width as f32 / target.height as f32;
     frame.draw(
         &model,
-        &StandardView::framed(&model, aspect, 1.0, args.angle),
+        &StandardView::framed(&model, 1.0, args.angle),
         target,
         &args.scene.options(),
         args.scene.mode,
@@ -194,6 +193,9 @@ fn text_frames(
     args: &PngArgs,
     mut render: impl FnMut(&mut crate::tui::viewport::Viewport, u32),
 ) -> Result<(), super::CliError> {
+    if let Some(n) = args.look.notice_in(|k| std::env::var(k).ok()) {
+        eprintln!("termrast: {n}");
+    }
     let mut vp = crate::tui::viewport::Viewport::default();
     let mut out = std::io::stdout().lock();
     for n in 0..args.frames {

@@ -7,16 +7,17 @@ use clap::Args;
 use crate::mesh::Mesh;
 use crate::render::standard::Model;
 use crate::render::wire::Mode;
-use crate::terminal::{ColorMode, GlyphMode};
+use crate::terminal::{ColorMode, GlyphMode, locale};
 use crate::tui::app::App;
 use crate::tui::viewport::{ViewSettings, Viewport};
 
 /// How the model is shown in the terminal (shared by `view` and text `render`).
 #[derive(Debug, Args, Clone)]
 pub struct LookArgs {
-    /// Sub-samples per cell.
-    #[arg(long, value_enum, default_value_t = GlyphMode::Braille)]
-    pub glyphs: GlyphMode,
+    /// Glyphs and sub-samples per cell; by default the best for the colour depth
+    /// (`ascii` when the locale is not UTF-8).
+    #[arg(long, value_enum)]
+    pub glyphs: Option<GlyphMode>,
     /// Colour depth; detected from NO_COLOR, COLORTERM and TERM when not given.
     #[arg(long, value_enum)]
     pub color: Option<ColorMode>,
@@ -35,19 +36,48 @@ fn parse_aspect(s: &str) -> Result<f32, String> {
 }
 
 impl LookArgs {
-    /// The view settings these arguments ask for.
+    /// The view settings these arguments ask for in this environment.
     #[must_use]
     pub fn settings(&self, mode: Mode, cull: bool) -> ViewSettings {
+        self.settings_in(mode, cull, |k| std::env::var(k).ok())
+    }
+
+    /// The view settings in an environment whose variables `get` returns.
+    #[must_use]
+    pub fn settings_in(
+        &self,
+        mode: Mode,
+        cull: bool,
+        get: impl Fn(&str) -> Option<String>,
+    ) -> ViewSettings {
+        let colors = self.color.unwrap_or_else(|| ColorMode::detect(&get));
+        let utf8 = locale::is_utf8(locale::locale(&get).as_deref());
+        let glyphs = match self.glyphs {
+            Some(g) => g,
+            None if !utf8 => GlyphMode::Ascii,
+            None => GlyphMode::default_for(colors),
+        };
         ViewSettings {
-            glyphs: self.glyphs,
-            colors: self
-                .color
-                .unwrap_or_else(|| ColorMode::detect(|k| std::env::var(k).ok())),
+            glyphs,
+            colors,
             mode,
             cell_aspect: self.cell_aspect,
             cull,
             ..ViewSettings::default()
         }
+    }
+
+    /// What to tell the user once about the settings: that a non-UTF-8 locale chose
+    /// ASCII glyphs.
+    #[must_use]
+    pub fn notice_in(&self, get: impl Fn(&str) -> Option<String>) -> Option<String> {
+        let name = locale::locale(&get);
+        (self.glyphs.is_none() && !locale::is_utf8(name.as_deref())).then(|| {
+            format!(
+                "locale {} is not UTF-8: ascii glyphs (--glyphs overrides)",
+                name.as_deref().unwrap_or("C")
+            )
+        })
     }
 }
 
@@ -80,19 +110,19 @@ pub fn load_model(spec: &str) -> Result<Model, crate::mesh::MeshError> {
 
 /// Runs the viewer.
 pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
-    if crate::scene::is_scene_path(&args.model) {
-        let scene = crate::scene::Scene::load(std::path::Path::new(&args.model))?;
-        crate::tui::run(
-            App::with_scene(scene, args.look.settings(args.mode, args.cull)),
-            args.fps,
-        )?;
-        return Ok(());
+    let env = |k: &str| std::env::var(k).ok();
+    if let Some(why) = locale::no_full_screen(env("TERM").as_deref()) {
+        return Err(crate::tui::ViewError::Unsupported(why).into());
     }
-    let model = load_model(&args.model)?;
-    crate::tui::run(
-        App::new(model, args.look.settings(args.mode, args.cull)),
-        args.fps,
-    )?;
+    let settings = args.look.settings(args.mode, args.cull);
+    let mut app = if crate::scene::is_scene_path(&args.model) {
+        let scene = crate::scene::Scene::load(std::path::Path::new(&args.model))?;
+        App::with_scene(scene, settings)
+    } else {
+        App::new(load_model(&args.model)?, settings)
+    };
+    app.notice = args.look.notice_in(env);
+    crate::tui::run(app, args.fps)?;
     Ok(())
 }
 

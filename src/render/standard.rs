@@ -46,12 +46,12 @@ impl StandardView {
         }
     }
 
-    /// The view of `model` that frames its bounding sphere (see [`Camera::framing`])
-    /// in a view `aspect` times as wide as it is tall, moved closer by `zoom`.
+    /// The view of `model` that frames its bounding sphere (see [`Camera::framing`]),
+    /// moved closer by `zoom`.
     #[must_use]
-    pub fn framed(model: &Model, aspect: f32, zoom: f32, angle: f32) -> Self {
+    pub fn framed(model: &Model, zoom: f32, angle: f32) -> Self {
         Self {
-            camera: Camera::framing(model.radius, aspect, zoom),
+            camera: Camera::framing(model.radius, zoom),
             ..Self::at(angle)
         }
     }

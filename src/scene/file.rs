@@ -14,8 +14,8 @@ use super::SceneError;
 pub struct SceneFile {
     #[serde(default)]
     pub render: RenderFile,
-    #[serde(default)]
-    pub camera: CameraFile,
+    /// Absent: the camera frames the objects' bounding sphere.
+    pub camera: Option<CameraFile>,
     #[serde(default, rename = "light")]
     pub lights: Vec<LightFile>,
     #[serde(default, rename = "object")]
@@ -325,36 +325,37 @@ fn validate(f: &SceneFile, text: &str, path: &Path) -> Result<(), SceneError> {
             "render.background must be finite".into(),
         ));
     }
-    let c = &f.camera;
-    if !(c.fov.is_finite() && c.fov > 1.0 && c.fov < 179.0) {
-        return Err(bad(
-            None,
-            "fov",
-            format!("camera.fov = {}: must be between 1 and 179 degrees", c.fov),
-        ));
-    }
-    if !(c.near.is_finite() && c.far.is_finite() && c.near > 0.0 && c.far > c.near) {
-        return Err(bad(
-            None,
-            "near",
-            format!(
-                "camera.near = {} and far = {}: need 0 < near < far",
-                c.near, c.far
-            ),
-        ));
-    }
-    let eye = Vec3::from(c.eye);
-    let dir = Vec3::from(c.target) - eye;
-    if !(finite3(c.eye) && finite3(c.target) && finite3(c.up))
-        || dir.length_squared() == 0.0
-        || dir.cross(Vec3::from(c.up)).length_squared() == 0.0
-    {
-        return Err(bad(
-            None,
-            "eye",
-            "camera: eye, target and up must be finite, eye ≠ target, and up not along the view"
-                .into(),
-        ));
+    if let Some(c) = &f.camera {
+        if !(c.fov.is_finite() && c.fov > 1.0 && c.fov < 179.0) {
+            return Err(bad(
+                None,
+                "fov",
+                format!("camera.fov = {}: must be between 1 and 179 degrees", c.fov),
+            ));
+        }
+        if !(c.near.is_finite() && c.far.is_finite() && c.near > 0.0 && c.far > c.near) {
+            return Err(bad(
+                None,
+                "near",
+                format!(
+                    "camera.near = {} and far = {}: need 0 < near < far",
+                    c.near, c.far
+                ),
+            ));
+        }
+        let eye = Vec3::from(c.eye);
+        let dir = Vec3::from(c.target) - eye;
+        if !(finite3(c.eye) && finite3(c.target) && finite3(c.up))
+            || dir.length_squared() == 0.0
+            || dir.cross(Vec3::from(c.up)).length_squared() == 0.0
+        {
+            return Err(bad(
+                None,
+                "eye",
+                "camera: eye, target and up must be finite, eye ≠ target, and up not along the view"
+                    .into(),
+            ));
+        }
     }
     for (i, l) in f.lights.iter().enumerate() {
         let sec = Some(("[[light]]", i));

@@ -67,6 +67,12 @@ impl ColorMode {
         }
     }
 
+    /// Whether two colours look the same in this mode (the same palette entry).
+    #[must_use]
+    pub fn same(self, a: Rgb, b: Rgb) -> bool {
+        a == b || (self != ColorMode::Truecolor && self.color(a) == self.color(b))
+    }
+
     /// The ratatui colour for an RGB colour in this mode (`Reset` in `None`).
     #[must_use]
     pub fn color(self, c: Rgb) -> Color {
@@ -76,6 +82,41 @@ impl ColorMode {
             ColorMode::Ansi16 => ANSI16[nearest(&ANSI16_RGB, c)],
             ColorMode::None => Color::Reset,
         }
+    }
+}
+
+/// sRGB-encoded 8-bit value to linear light, 0..1.
+#[must_use]
+pub fn to_linear(v: u8) -> f32 {
+    linear_table()[usize::from(v)]
+}
+
+fn linear_table() -> &'static [f32; 256] {
+    static T: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    T.get_or_init(|| {
+        std::array::from_fn(|i| {
+            let c = i as f32 / 255.0;
+            if c <= 0.04045 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        })
+    })
+}
+
+/// Linear light to the nearest sRGB-encoded 8-bit value (exact: a search of the table
+/// of all 256 values).
+#[must_use]
+pub fn to_srgb(l: f32) -> u8 {
+    let t = linear_table();
+    // The first value whose linear level is at least l, then the nearer of it and the
+    // one below.
+    let i = t.partition_point(|&v| v < l).min(255);
+    if i > 0 && (l - t[i - 1]) <= (t[i] - l) {
+        (i - 1) as u8
+    } else {
+        i as u8
     }
 }
 
@@ -149,5 +190,20 @@ pub fn nearest_256(c: Rgb) -> u8 {
         232 + gi
     } else {
         16 + 36 * r as u8 + 6 * g as u8 + b as u8
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn linear_light_round_trips() {
+        for v in 0..=255u8 {
+            assert_eq!(to_srgb(to_linear(v)), v);
+        }
+        assert_eq!(to_srgb(-1.0), 0);
+        assert_eq!(to_srgb(2.0), 255);
+        assert!((to_linear(128) - 0.2158).abs() < 1e-3);
     }
 }

@@ -1,17 +1,22 @@
 //! Glyph modes and the choice of a cell's glyph and two colours from its samples.
 //!
-//! Samples are row-major within the cell. For the block and braille modes the cell is
-//! fitted with two colours: samples are ordered by luminance and split where the summed
-//! squared colour error of the two groups is smallest; the brighter group sets the
-//! glyph's pattern and foreground, the darker one the background (or the terminal's
-//! own background when that group is all uncovered).
+//! Samples are row-major within the cell. `blocks` and `ascii` take 4 × 8 samples and
+//! choose the glyph and two colours that minimise the squared error in linear light
+//! over a repertoire of shapes ([`super::fit`]). The other modes split their samples,
+//! ordered by luminance, where the summed squared colour error of the two groups is
+//! smallest; block modes draw the brighter group in the foreground, braille puts its
+//! dots on the smaller group (dots ink only a third of the cell, so the colour that
+//! covers the cell's area is the background). A cell of one colour is a space on that
+//! background in every mode that has one; without colour, shading is carried by ink
+//! density.
 
-use super::color::Rgb;
+use super::color::{ColorMode, Rgb, to_linear, to_srgb};
+use super::fit::{self, Repertoire};
 
 /// How a cell is divided into samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum GlyphMode {
-    /// One sample, a luminance ramp of printable ASCII.
+    /// Printable ASCII chosen by shape (4×8 samples) with two colours.
     Ascii,
     /// 1×2: upper half block with foreground and background.
     Half,
@@ -22,10 +27,10 @@ pub enum GlyphMode {
     /// 2×4 braille dots.
     #[default]
     Braille,
+    /// 4×8 samples fitted with halves, quadrants, sextants, eighths and diagonal
+    /// wedges (Unicode 13 legacy computing symbols).
+    Blocks,
 }
-
-/// The ASCII ramp, darkest first.
-pub const ASCII_RAMP: &[u8] = b" .:-=+*#%@";
 
 const QUADRANTS: [char; 16] = [
     ' ', '▘', '▝', '▀', '▖', '▌', '▞', '▛', '▗', '▚', '▐', '▜', '▄', '▙', '▟', '█',
@@ -33,19 +38,32 @@ const QUADRANTS: [char; 16] = [
 
 impl GlyphMode {
     /// Cycling order.
-    pub const ALL: [GlyphMode; 5] = [
+    pub const ALL: [GlyphMode; 6] = [
         GlyphMode::Ascii,
         GlyphMode::Half,
         GlyphMode::Quadrant,
         GlyphMode::Sextant,
         GlyphMode::Braille,
+        GlyphMode::Blocks,
     ];
+
+    /// The default glyph mode for a colour depth (see the fidelity table in the README).
+    #[must_use]
+    pub fn default_for(colors: ColorMode) -> Self {
+        match colors {
+            ColorMode::None => GlyphMode::Braille,
+            _ => GlyphMode::Blocks,
+        }
+    }
+
+    /// Most samples of any mode's cell.
+    pub const MAX_SAMPLES: usize = fit::N;
 
     /// Samples per cell, (columns, rows).
     #[must_use]
     pub fn dims(self) -> (u32, u32) {
         match self {
-            GlyphMode::Ascii => (1, 1),
+            GlyphMode::Ascii | GlyphMode::Blocks => (fit::SX as u32, fit::SY as u32),
             GlyphMode::Half => (1, 2),
             GlyphMode::Quadrant => (2, 2),
             GlyphMode::Sextant => (2, 3),
@@ -62,25 +80,27 @@ impl GlyphMode {
             GlyphMode::Quadrant => "quadrant",
             GlyphMode::Sextant => "sextant",
             GlyphMode::Braille => "braille",
+            GlyphMode::Blocks => "blocks",
         }
     }
 
     /// The glyph showing the samples whose bits are set in `pattern` (bit i = sample
-    /// i, row-major).
+    /// i, row-major), for the modes whose glyphs are patterns of their samples.
     #[must_use]
-    pub fn pattern_glyph(self, pattern: u8) -> char {
+    pub fn pattern_glyph(self, pattern: u32) -> char {
+        let p = pattern as u8;
         match self {
-            GlyphMode::Ascii => {
-                if pattern & 1 == 1 {
-                    '#'
-                } else {
+            GlyphMode::Ascii | GlyphMode::Blocks => {
+                if pattern == 0 {
                     ' '
+                } else {
+                    '█'
                 }
             }
-            GlyphMode::Half => [' ', '▀', '▄', '█'][usize::from(pattern & 3)],
-            GlyphMode::Quadrant => QUADRANTS[usize::from(pattern & 15)],
-            GlyphMode::Sextant => sextant(pattern & 63),
-            GlyphMode::Braille => braille(pattern),
+            GlyphMode::Half => [' ', '▀', '▄', '█'][usize::from(p & 3)],
+            GlyphMode::Quadrant => QUADRANTS[usize::from(p & 15)],
+            GlyphMode::Sextant => sextant(p & 63),
+            GlyphMode::Braille => braille(p),
         }
     }
 }
@@ -106,8 +126,10 @@ pub fn sextant(p: u8) -> char {
 /// numbers its dots down the left column (1, 2, 3, then 7) and the right (4, 5, 6, 8).
 #[must_use]
 pub fn braille(p: u8) -> char {
-    const DOT: [u32; 8] = [0x01, 0x08, 0x02, 0x10, 0x04, 0x20, 0x40, 0x80];
-    let bits: u32 = (0..8).filter(|i| p >> i & 1 == 1).map(|i| DOT[i]).sum();
+    let bits: u32 = (0..8)
+        .filter(|i| p >> i & 1 == 1)
+        .map(|i| super::shapes::BRAILLE_BITS[i])
+        .sum();
     char::from_u32(0x2800 + bits).unwrap_or(' ')
 }
 
@@ -126,7 +148,7 @@ pub fn luma(c: Rgb) -> f32 {
 
 /// A cell's glyph and colours. `Copy` and allocation-free: the viewer fits every
 /// cell every frame; [`explain`] says why, on demand.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CellGlyph {
     pub ch: char,
     /// Foreground colour, or the terminal's default.
@@ -134,19 +156,35 @@ pub struct CellGlyph {
     /// Background colour, or the terminal's default.
     pub bg: Option<Rgb>,
     /// Samples drawn in the foreground.
-    pub pattern: u8,
-    /// Squared colour error of the fit (0 for exact modes).
-    pub error: u32,
+    pub pattern: u32,
+    /// Squared colour error of the fit (8-bit sRGB units, or linear light for the
+    /// shape-fitted modes; 0 for exact modes).
+    pub error: f32,
+}
+
+impl Default for CellGlyph {
+    fn default() -> Self {
+        Self::EMPTY
+    }
 }
 
 impl CellGlyph {
-    const EMPTY: Self = Self {
+    /// A space on the terminal's own background.
+    pub const EMPTY: Self = Self {
         ch: ' ',
         fg: None,
         bg: None,
         pattern: 0,
-        error: 0,
+        error: 0.0,
     };
+
+    /// A space on a background of `c`.
+    fn uniform(c: Rgb) -> Self {
+        Self {
+            bg: Some(c),
+            ..Self::EMPTY
+        }
+    }
 }
 
 /// Why [`fit_cell`] chose `g` for these samples, for the inspector.
@@ -155,25 +193,51 @@ pub fn explain(mode: GlyphMode, samples: &[Sample], g: &CellGlyph) -> String {
     if samples.iter().all(|s| !s.covered) {
         return "no sample covered: blank".into();
     }
-    if g.fg.is_none() && mode != GlyphMode::Ascii {
-        return format!(
-            "no colour: ordered dither, {} of {} samples bright enough",
-            g.pattern.count_ones(),
-            samples.len()
-        );
+    let shaped = matches!(mode, GlyphMode::Ascii | GlyphMode::Blocks);
+    if g.fg.is_none() && g.bg.is_none() {
+        return if shaped {
+            format!(
+                "no colour: the glyph whose ink density best matches the samples' \
+                 (2×2-sample boxes), squared error {:.3}",
+                g.error
+            )
+        } else {
+            format!(
+                "no colour: ordered dither, {} of {} samples bright enough",
+                g.pattern.count_ones(),
+                samples.len()
+            )
+        };
+    }
+    if g.ch == ' ' {
+        return "one colour fits best: a space on that background".into();
     }
     match mode {
-        GlyphMode::Ascii => format!(
-            "luminance {:.2} on the ramp \" .:-=+*#%@\" → '{}'",
-            luma(samples[0].rgb),
-            g.ch
-        ),
         GlyphMode::Half => "upper half block: top sample is fg, bottom is bg".into(),
-        _ => {
-            let bright = g.pattern.count_ones();
+        GlyphMode::Ascii | GlyphMode::Blocks => {
+            let (rep, what) = if mode == GlyphMode::Blocks {
+                (Repertoire::blocks(), "block shapes")
+            } else {
+                (Repertoire::ascii(), "ASCII shapes")
+            };
             format!(
-                "2-colour fit by luminance split: {bright} bright (fg) / {} dark (bg) samples, squared error {}",
-                samples.len() as u32 - bright,
+                "best of {} {what} and two colours in linear light: {} fg samples, \
+                 squared error {:.4}",
+                rep.shapes.len() + 1,
+                g.pattern.count_ones(),
+                g.error
+            )
+        }
+        _ => {
+            let on = g.pattern.count_ones();
+            let rule = if mode == GlyphMode::Braille {
+                "the smaller group on the dots"
+            } else {
+                "the brighter group in fg"
+            };
+            format!(
+                "2-colour fit by luminance split, {rule}: {on} fg / {} bg samples, squared error {}",
+                samples.len() as u32 - on,
                 g.error
             )
         }
@@ -198,57 +262,66 @@ fn mean(samples: &[Sample], idx: impl Iterator<Item = usize> + Clone) -> Option<
 /// so that brightness fills a cell evenly.
 fn dither_rank(mode: GlyphMode) -> &'static [u8] {
     match mode {
-        GlyphMode::Ascii => &[0],
         GlyphMode::Half => &[0, 1],
         GlyphMode::Quadrant => &[0, 2, 3, 1],
         GlyphMode::Sextant => &[0, 3, 4, 1, 2, 5],
-        GlyphMode::Braille => &[0, 4, 6, 2, 3, 7, 5, 1],
+        _ => &[0, 4, 6, 2, 3, 7, 5, 1],
     }
 }
 
-/// Chooses the glyph and colours of a cell from its samples (`mode.dims()` of them).
-/// With `colorless`, block and braille modes carry shading by ordered dithering (a
-/// sample is drawn when its luminance exceeds its threshold) instead of a two-colour
-/// fit, since there are no colours to carry it.
+/// The shade glyph (` ░▒▓█`) nearest a luminance, for uniform cells without colour.
+fn shade(l: f32) -> char {
+    [' ', '░', '▒', '▓', '█'][((l * 4.0).round() as usize).min(4)]
+}
+
+/// Chooses the glyph and colours of a cell from its samples (`mode.dims()` of them)
+/// for a terminal of colour depth `colors`. Without colour, block and braille modes
+/// carry shading by ordered dithering (a sample is drawn when its luminance exceeds its
+/// threshold), and the shape-fitted modes by ink density.
 #[must_use]
-pub fn fit_cell(mode: GlyphMode, samples: &[Sample], colorless: bool) -> CellGlyph {
+pub fn fit_cell(mode: GlyphMode, samples: &[Sample], colors: ColorMode) -> CellGlyph {
     if samples.iter().all(|s| !s.covered) {
         return CellGlyph::EMPTY;
     }
-    if colorless && mode != GlyphMode::Ascii {
+    let colorless = colors == ColorMode::None;
+    if matches!(mode, GlyphMode::Ascii | GlyphMode::Blocks) {
+        return shape_cell(repertoire(mode), samples, colors);
+    }
+    let uniform = samples.iter().all(|s| *s == samples[0]);
+    if colorless {
+        if uniform {
+            return CellGlyph {
+                ch: shade(luma(samples[0].rgb)),
+                ..CellGlyph::EMPTY
+            };
+        }
         let rank = dither_rank(mode);
         let n = samples.len() as f32;
         let pattern = samples
             .iter()
             .zip(rank)
             .enumerate()
-            .fold(0u8, |p, (i, (s, &r))| {
+            .fold(0u32, |p, (i, (s, &r))| {
                 let on = s.covered && luma(s.rgb) >= (f32::from(r) + 0.5) / n;
-                p | u8::from(on) << i
+                p | u32::from(on) << i
             });
+        // Every dot lit would still show the background between them.
+        let all = (1u32 << samples.len()) - 1;
+        let ch = if mode == GlyphMode::Braille && pattern == all {
+            '█'
+        } else {
+            mode.pattern_glyph(pattern)
+        };
         return CellGlyph {
-            ch: mode.pattern_glyph(pattern),
-            fg: None,
-            bg: None,
+            ch,
             pattern,
-            error: 0,
+            ..CellGlyph::EMPTY
         };
     }
-    match mode {
-        GlyphMode::Ascii => {
-            let s = samples[0];
-            let l = luma(s.rgb);
-            let i = ((l * (ASCII_RAMP.len() - 1) as f32).round() as usize)
-                .clamp(1, ASCII_RAMP.len() - 1);
-            let ch = ASCII_RAMP[i] as char;
-            CellGlyph {
-                ch,
-                fg: Some(s.rgb),
-                bg: None,
-                pattern: 1,
-                error: 0,
-            }
-        }
+    if uniform {
+        return CellGlyph::uniform(samples[0].rgb);
+    }
+    let g = match mode {
         GlyphMode::Half => {
             let (t, b) = (samples[0], samples[1]);
             let (ch, fg, bg, pattern) = match (t.covered, b.covered) {
@@ -261,12 +334,127 @@ pub fn fit_cell(mode: GlyphMode, samples: &[Sample], colorless: bool) -> CellGly
                 fg,
                 bg,
                 pattern,
-                error: 0,
+                error: 0.0,
             }
         }
         _ => fit_two_colours(mode, samples),
+    };
+    merge_if_same(g, colors)
+}
+
+/// A cell whose two colours are one palette entry in this colour depth is a space on
+/// it: the same picture in fewer bytes.
+fn merge_if_same(g: CellGlyph, colors: ColorMode) -> CellGlyph {
+    match (g.fg, g.bg) {
+        (Some(f), Some(b)) if colors.same(f, b) => CellGlyph {
+            error: g.error,
+            ..CellGlyph::uniform(b)
+        },
+        _ => g,
     }
 }
+
+/// The repertoire of a shape-fitted mode.
+fn repertoire(mode: GlyphMode) -> &'static Repertoire {
+    if mode == GlyphMode::Blocks {
+        Repertoire::blocks()
+    } else {
+        Repertoire::ascii()
+    }
+}
+
+/// The samples of a cell in linear light, and which are covered (bit `i`).
+fn linear(samples: &[Sample]) -> ([[f32; 3]; fit::N], u32) {
+    let mut x = [[0f32; 3]; fit::N];
+    let mut covered = 0;
+    for (i, (px, s)) in x.iter_mut().zip(samples).enumerate() {
+        *px = s.rgb.map(to_linear);
+        covered |= u32::from(s.covered) << i;
+    }
+    (x, covered)
+}
+
+/// Fits a cell of 4 × 8 samples with the shapes of `rep`.
+fn shape_cell(rep: &Repertoire, samples: &[Sample], colors: ColorMode) -> CellGlyph {
+    let (x, covered) = linear(samples);
+    if colors == ColorMode::None {
+        let l: [f32; fit::N] = std::array::from_fn(|i| {
+            let [r, g, b] = x[i];
+            0.2126 * r + 0.7152 * g + 0.0722 * b
+        });
+        let (ch, error) = fit::fit_ink(rep, &l, to_linear(DEFAULT_FG_LEVEL));
+        let pattern = fit::mask_of(ch).unwrap_or(0);
+        return CellGlyph {
+            ch,
+            pattern,
+            error,
+            ..CellGlyph::EMPTY
+        };
+    }
+    glyph_of(&fit::fit(rep, &x), covered, colors)
+}
+
+/// Fits up to 8 cells of 4 × 8 samples (`cells[k]` holds cell `k`'s) in colour, all at
+/// once: [`fit_cell`]'s result for each, in its lanes.
+pub fn fit_cells8(
+    mode: GlyphMode,
+    cells: &[[Sample; fit::N]],
+    colors: ColorMode,
+    out: &mut [CellGlyph],
+) {
+    debug_assert!(colors != ColorMode::None && cells.len() <= 8 && out.len() == cells.len());
+    let mut lanes = [[[0f32; 8]; 3]; fit::N];
+    let mut covered = [0u32; 8];
+    for (l, cell) in cells.iter().enumerate() {
+        for (i, s) in cell.iter().enumerate() {
+            for c in 0..3 {
+                lanes[i][c][l] = to_linear(s.rgb[c]);
+            }
+            covered[l] |= u32::from(s.covered) << i;
+        }
+    }
+    let x = lanes.map(|px| px.map(wide::f32x8::new));
+    let fits = fit::fit_lanes(repertoire(mode), &x);
+    for (l, g) in out.iter_mut().enumerate() {
+        *g = if covered[l] == 0 {
+            CellGlyph::EMPTY
+        } else {
+            glyph_of(&fits[l], covered[l], colors)
+        };
+    }
+}
+
+/// The glyph and colours that show a fit: a side with no covered sample is the
+/// terminal's own background (with the complementary glyph if that puts it there).
+fn glyph_of(f: &fit::Fit, covered: u32, colors: ColorMode) -> CellGlyph {
+    let srgb = |c: [f32; 3]| c.map(to_srgb);
+    let Some(sh) = f.shape else {
+        return CellGlyph {
+            error: f.error,
+            ..CellGlyph::uniform(srgb(f.on))
+        };
+    };
+    let (ch, pattern, fg, bg) = if covered & !sh.mask == 0 {
+        (sh.ch, sh.mask, srgb(f.on), None)
+    } else if let (0, Some(inv)) = (covered & sh.mask, sh.inverse) {
+        (inv, !sh.mask, srgb(f.off), None)
+    } else {
+        (sh.ch, sh.mask, srgb(f.on), Some(srgb(f.off)))
+    };
+    merge_if_same(
+        CellGlyph {
+            ch,
+            fg: Some(fg),
+            bg,
+            pattern,
+            error: f.error,
+        },
+        colors,
+    )
+}
+
+/// The terminal's default foreground level assumed without colour (xterm's colour 7).
+pub const DEFAULT_FG_LEVEL: u8 = 229;
 
 /// `1/m` for group sizes 0..=8 (0 for an empty group, whose sum is 0 anyway).
 const INV: [f32; 9] = [
@@ -382,15 +570,29 @@ fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph {
             (best, split) = (score, cut);
         }
     }
-    let best_err = sse(0, split) + sse(split, n);
+    let error = (sse(0, split) + sse(split, n)) as f32;
     let (dark, bright) = order.split_at(split);
-    let pattern = bright.iter().fold(0u8, |p, &i| p | 1 << i);
-    let fg = mean(samples, bright.iter().copied());
-    let bg = mean(
-        samples,
-        dark.iter().copied().filter(|&i| samples[i].covered),
-    );
-    let error = best_err;
+    if dark.is_empty() {
+        // One group: the cell is best shown as its mean colour.
+        return CellGlyph {
+            error,
+            ..CellGlyph::uniform(mean(samples, 0..n).unwrap_or_default())
+        };
+    }
+    // Braille dots ink a third of the cell, so the group they draw shows at a third of
+    // its strength: they go on the smaller group, and the larger one covers the cell.
+    let (dots, rest) = if mode == GlyphMode::Braille && bright.len() > dark.len() {
+        (dark, bright)
+    } else {
+        (bright, dark)
+    };
+    let pattern = dots.iter().fold(0u32, |p, &i| p | 1 << i);
+    let fg = mean(samples, dots.iter().copied());
+    let bg = if rest.iter().all(|&i| !samples[i].covered) {
+        None
+    } else {
+        mean(samples, rest.iter().copied())
+    };
     CellGlyph {
         ch: mode.pattern_glyph(pattern),
         fg,

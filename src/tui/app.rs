@@ -50,6 +50,8 @@ pub struct App {
     pub bytes: u64,
     /// The status line text, reused every frame.
     pub status: String,
+    /// Said once at the start of the status line, until the first key.
+    pub notice: Option<String>,
     drag: Option<(u16, u16)>,
     /// Area of the viewport on screen, from the last draw.
     view_area: Rect,
@@ -87,6 +89,7 @@ impl App {
             output_time: Duration::ZERO,
             bytes: 0,
             status: String::with_capacity(256),
+            notice: None,
             drag: None,
             view_area: Rect::default(),
             scene: None,
@@ -199,6 +202,7 @@ impl App {
     }
 
     fn key(&mut self, k: KeyEvent) -> bool {
+        self.notice = None;
         let ctrl = k.modifiers.contains(KeyModifiers::CONTROL);
         match k.code {
             KeyCode::Char('c') if ctrl => self.quit = true,
@@ -389,6 +393,9 @@ impl App {
         };
         // State first, so it stays visible when a narrow terminal cuts the line.
         self.status.clear();
+        if let Some(n) = &self.notice {
+            let _ = write!(self.status, "{n} | ");
+        }
         let _ = write!(
             self.status,
             "{}{}{} {} {} | {:.0} fps | transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms | tris {} drawn {} culled {} clipped | {} B | ? help",

@@ -11,6 +11,7 @@ use crate::render::Shader;
 use crate::render::standard::{Model, StandardFrame};
 use crate::render::target::luminance;
 use crate::render::wire::{ScreenLine, probe_lines, project_edge};
+use crate::terminal::GlyphMode;
 use crate::terminal::glyphs::{Sample, explain};
 
 use super::app::SceneState;
@@ -32,7 +33,11 @@ fn hex(c: Option<[u8; 3]>) -> String {
 
 /// The first lines of the inspector: the cell's glyph and colours and why; with the
 /// cell's samples and their count. `None` outside the view.
-fn cell_header(vp: &Viewport, cx: u16, cy: u16) -> Option<(String, [Sample; 8], usize)> {
+fn cell_header(
+    vp: &Viewport,
+    cx: u16,
+    cy: u16,
+) -> Option<(String, [Sample; GlyphMode::MAX_SAMPLES], usize)> {
     let g = vp.cell(cx, cy)?;
     let (samples, n) = vp.samples(cx, cy);
     let mut t = String::new();
@@ -47,6 +52,17 @@ fn cell_header(vp: &Viewport, cx: u16, cy: u16) -> Option<(String, [Sample; 8], 
     Some((t, samples, n))
 }
 
+/// The samples the panel lists: all of a small cell, the selected sample's row of a
+/// 4 × 8 one (32 lines would push the overdraw list off the panel).
+fn listed(vp: &Viewport, n: usize, sub: usize) -> std::ops::Range<usize> {
+    if n <= 8 {
+        return 0..n;
+    }
+    let sx = vp.settings.glyphs.dims().0 as usize;
+    let row = (sub % n) / sx;
+    row * sx..(row + 1) * sx
+}
+
 /// The inspector text for cell `(cx, cy)`, detailing sub-sample `sub`.
 #[must_use]
 pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize) -> String {
@@ -57,10 +73,20 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
     let indices = &model.mesh.indices;
     let view = vp.view;
     let shader = StandardFrame::shader(&model.mesh, &view, vp.target);
-    let _ = writeln!(t, "samples ({} per cell):", n);
+    let rows = listed(vp, n, sub);
+    if rows.len() < n {
+        let _ = writeln!(
+            t,
+            "samples {}–{} of {n} (Tab moves):",
+            rows.start,
+            rows.end - 1
+        );
+    } else {
+        let _ = writeln!(t, "samples ({n} per cell):");
+    }
     // The selected sample's probe is kept for the overdraw list below.
     let mut selected = None;
-    for k in 0..n {
+    for k in rows {
         let (x, y) = sample_pixel(vp, cx, cy, k);
         let p = probe(&vp.frame.cache, indices, vp.target, &opts, x, y);
         let mark = if k == sub % n { '>' } else { ' ' };
@@ -145,7 +171,8 @@ pub fn scene_inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub
     let Some((mut t, samples, n)) = cell_header(vp, cx, cy) else {
         return "cursor outside the view".into();
     };
-    for (k, smp) in samples[..n].iter().enumerate() {
+    for k in listed(vp, n, sub) {
+        let smp = samples[k];
         let mark = if k == sub % n { '>' } else { ' ' };
         let (x, y) = sample_pixel(vp, cx, cy, k);
         let _ = writeln!(

@@ -14,7 +14,8 @@ use crate::render::wire::Mode;
 use crate::render::{Cull, DrawOptions, Rgba8};
 use crate::scene::Scene;
 use crate::scene::render::{SceneFrame, SceneView};
-use crate::terminal::glyphs::{Sample, fit_cell};
+use crate::terminal::fit;
+use crate::terminal::glyphs::{Sample, fit_cell, fit_cells8};
 use crate::terminal::{CellGlyph, ColorMode, GlyphMode};
 
 /// What the viewer shows and how.
@@ -48,13 +49,12 @@ impl Default for ViewSettings {
 }
 
 impl ViewSettings {
-    /// The camera and model rotation for a `cols × rows` cell view of `model`, for a
-    /// glyph mode's samples: the model's bounding sphere framed at zoom 1.
+    /// The camera and model rotation for `model`, for a glyph mode's samples: the
+    /// model's bounding sphere framed at zoom 1, whatever the view's aspect.
     #[must_use]
-    pub fn view(&self, model: &Model, cols: u16, rows: u16) -> StandardView {
+    pub fn view(&self, model: &Model) -> StandardView {
         let (sx, sy) = self.glyphs.dims();
-        let aspect = f32::from(cols.max(1)) * self.cell_aspect / f32::from(rows.max(1));
-        let mut v = StandardView::framed(model, aspect, self.zoom, self.angle);
+        let mut v = StandardView::framed(model, self.zoom, self.angle);
         v.tilt = self.tilt;
         v.pixel_aspect = self.cell_aspect * sy as f32 / sx as f32;
         v
@@ -110,7 +110,7 @@ impl Viewport {
     /// Renders the model for a `cols × rows` cell area and fits every cell's glyph.
     pub fn render(&mut self, model: &Model, settings: &ViewSettings, cols: u16, rows: u16) {
         let target = self.lay_out(settings, cols, rows);
-        self.view = settings.view(model, cols, rows);
+        self.view = settings.view(model);
         self.wire_pixels = self.frame.draw(
             model,
             &self.view,
@@ -201,17 +201,35 @@ impl Viewport {
         self.cells.clear();
         self.cells
             .resize(usize::from(cols) * usize::from(rows), CellGlyph::default());
-        // One sample buffer filled in place: returning it by value per cell cost a
-        // stalled wide copy of bytes just written one at a time.
-        let mut s = [Sample::default(); 8];
-        for cy in 0..rows {
-            for cx in 0..cols {
-                let n = self.samples_into(cx, cy, &mut s);
-                self.cells[usize::from(cy) * usize::from(cols) + usize::from(cx)] = fit_cell(
-                    self.settings.glyphs,
-                    &s[..n],
-                    self.settings.colors == ColorMode::None,
-                );
+        let (mode, colors) = (self.settings.glyphs, self.settings.colors);
+        if mode.dims() == (fit::SX as u32, fit::SY as u32) && colors != ColorMode::None {
+            // The shape fit runs 8 cells at a time, in lanes; a batch of empty cells
+            // (most of the background) is skipped.
+            let mut batch = [[Sample::default(); fit::N]; 8];
+            for cy in 0..rows {
+                for x0 in (0..cols).step_by(8) {
+                    let n = usize::from((cols - x0).min(8));
+                    let mut any = false;
+                    for (k, cell) in batch[..n].iter_mut().enumerate() {
+                        self.samples_into(x0 + k as u16, cy, cell);
+                        any |= cell.iter().any(|s| s.covered);
+                    }
+                    if any {
+                        let i = usize::from(cy) * usize::from(cols) + usize::from(x0);
+                        fit_cells8(mode, &batch[..n], colors, &mut self.cells[i..i + n]);
+                    }
+                }
+            }
+        } else {
+            // One sample buffer filled in place: returning it by value per cell cost a
+            // stalled wide copy of bytes just written one at a time.
+            let mut s = [Sample::default(); GlyphMode::MAX_SAMPLES];
+            for cy in 0..rows {
+                for cx in 0..cols {
+                    let n = self.samples_into(cx, cy, &mut s);
+                    self.cells[usize::from(cy) * usize::from(cols) + usize::from(cx)] =
+                        fit_cell(mode, &s[..n], colors);
+                }
             }
         }
         self.glyph_time = start.elapsed();
@@ -219,15 +237,15 @@ impl Viewport {
 
     /// The samples of cell `(cx, cy)`, row-major, and how many there are.
     #[must_use]
-    pub fn samples(&self, cx: u16, cy: u16) -> ([Sample; 8], usize) {
-        let mut out = [Sample::default(); 8];
+    pub fn samples(&self, cx: u16, cy: u16) -> ([Sample; GlyphMode::MAX_SAMPLES], usize) {
+        let mut out = [Sample::default(); GlyphMode::MAX_SAMPLES];
         let n = self.samples_into(cx, cy, &mut out);
         (out, n)
     }
 
     /// [`Viewport::samples`] into `out`.
     #[inline]
-    fn samples_into(&self, cx: u16, cy: u16, out: &mut [Sample; 8]) -> usize {
+    fn samples_into(&self, cx: u16, cy: u16, out: &mut [Sample; GlyphMode::MAX_SAMPLES]) -> usize {
         let (sx, sy) = self.settings.glyphs.dims();
         let w = self.target.width as usize;
         for j in 0..sy {

@@ -7,6 +7,7 @@
 
 pub mod color;
 pub mod glyphs;
+pub mod paint;
 pub mod shapes;
 
 pub use color::{ColorMode, Rgb};

@@ -151,3 +151,116 @@ pub fn nearest_256(c: Rgb) -> u8 {
         16 + 36 * r as u8 + 6 * g as u8 + b as u8
     }
 }
+
+/// The six levels of each channel in the xterm 6×6×6 colour cube (indices 16–231).
+const CUBE_LEVELS: [u8; 6] = [0, 95, 135, 175, 215, 255];
+
+/// The RGB colour xterm shows for palette index `i`: the 16 ANSI colours, the 6×6×6
+/// cube (16–231) or the grey ramp `8 + 10k` (232–255). The inverse of
+/// [`nearest_256`], for painting what a terminal shows.
+#[must_use]
+pub fn indexed_rgb(i: u8) -> Rgb {
+    match i {
+        0..=15 => ANSI16_RGB[usize::from(i)],
+        16..=231 => {
+            let c = i - 16;
+            [c / 36, c / 6 % 6, c % 6].map(|l| CUBE_LEVELS[usize::from(l)])
+        }
+        _ => [8 + 10 * (i - 232); 3],
+    }
+}
+
+/// The sRGB transfer curve's inverse for every 8-bit value, computed once.
+fn srgb_table() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        std::array::from_fn(|v| {
+            let c = v as f32 / 255.0;
+            if c <= 0.040_45 {
+                c / 12.92
+            } else {
+                ((c + 0.055) / 1.055).powf(2.4)
+            }
+        })
+    })
+}
+
+/// An 8-bit sRGB channel as linear light in `[0, 1]`: blending and filtering are done
+/// there, since that is how light adds up on a screen and in the eye.
+#[must_use]
+#[inline]
+pub fn srgb_to_linear(v: u8) -> f32 {
+    srgb_table()[usize::from(v)]
+}
+
+/// Linear light in `[0, 1]` (clamped) encoded with the sRGB transfer curve, in `[0, 1]`.
+#[must_use]
+#[inline]
+pub fn linear_to_srgb(v: f32) -> f32 {
+    let v = v.clamp(0.0, 1.0);
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// [`linear_to_srgb`] rounded to an 8-bit channel.
+#[must_use]
+#[inline]
+pub fn linear_to_srgb8(v: f32) -> u8 {
+    (linear_to_srgb(v) * 255.0 + 0.5) as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn palette_indices_round_trip() {
+        // Every cube and grey-ramp entry is its own nearest colour (the 16 ANSI
+        // colours repeat some of them and are not searched by `nearest_256`).
+        for i in 16..=255u8 {
+            assert_eq!(nearest_256(indexed_rgb(i)), i, "index {i}");
+        }
+        assert_eq!(indexed_rgb(16), [0, 0, 0]);
+        assert_eq!(indexed_rgb(196), [255, 0, 0]);
+        assert_eq!(indexed_rgb(231), [255, 255, 255]);
+        assert_eq!(indexed_rgb(232), [8, 8, 8]);
+        assert_eq!(indexed_rgb(255), [238, 238, 238]);
+        assert_eq!(indexed_rgb(7), [229, 229, 229]);
+    }
+
+    #[test]
+    fn nearest_256_is_close() {
+        // The cube's widest gap is 95 (0 to 95), so its nearest entry is at most 47.5
+        // off per channel; the grey ramp is taken only when it is nearer still. Over a
+        // grid of colours the mean error stays small.
+        let mut total = 0i64;
+        let mut n = 0i64;
+        for r in (0..=255u8).step_by(15) {
+            for g in (0..=255u8).step_by(15) {
+                for b in (0..=255u8).step_by(15) {
+                    let c = [r, g, b];
+                    let got = indexed_rgb(nearest_256(c));
+                    let d = dist2(got, c);
+                    assert!(d <= 3 * 48 * 48, "{c:?} -> {got:?}");
+                    total += i64::from(d);
+                    n += 1;
+                }
+            }
+        }
+        let rms = ((total / n) as f64 / 3.0).sqrt();
+        assert!(rms < 20.0, "rms channel error {rms}");
+    }
+
+    #[test]
+    fn transfer_curve_round_trips() {
+        for v in 0..=255u8 {
+            assert_eq!(linear_to_srgb8(srgb_to_linear(v)), v);
+        }
+        assert_eq!(srgb_to_linear(0), 0.0);
+        assert!((srgb_to_linear(255) - 1.0).abs() < 1e-6);
+        assert!((srgb_to_linear(188) - 0.5).abs() < 0.005);
+    }
+}

@@ -4,6 +4,7 @@
 
 pub mod accuracy_cmd;
 pub mod effects_cmd;
+pub mod fidelity_cmd;
 pub mod line_cmd;
 pub mod raster_cmd;
 pub mod render_cmd;
@@ -59,6 +60,10 @@ pub enum BenchCommand {
     Accuracy(accuracy_cmd::AccuracyArgs),
     /// What each scene effect costs: ms/frame with and without it.
     Effects(effects_cmd::EffectsArgs),
+    /// How close what a terminal shows comes to the image: SSIM, PSNR and bytes per
+    /// frame of every glyph mode and colour depth (and chafa's, if installed),
+    /// through a terminal emulator.
+    Fidelity(fidelity_cmd::FidelityArgs),
 }
 
 /// Errors of the commands, each naming what it is about.
@@ -76,6 +81,8 @@ pub enum CliError {
     View(#[from] crate::tui::ViewError),
     #[error(transparent)]
     Scene(#[from] crate::scene::SceneError),
+    #[error(transparent)]
+    Fidelity(#[from] crate::fidelity::FidelityError),
     #[error(transparent)]
     Io(#[from] io::Error),
 }
@@ -149,6 +156,9 @@ pub fn main() -> ExitCode {
         }
         Some(Command::Bench(BenchCommand::Effects(args))) => {
             effects_cmd::run(&args, &mut io::stdout().lock())
+        }
+        Some(Command::Bench(BenchCommand::Fidelity(args))) => {
+            fidelity_cmd::run(&args, &mut io::stdout().lock())
         }
         Some(Command::View(args)) => view_cmd::view(&args),
         None => view_cmd::view(&cli.view),

@@ -7,6 +7,7 @@ pub mod accuracy;
 pub mod camera;
 pub mod cli;
 pub mod counters;
+pub mod fidelity;
 pub mod memory;
 pub mod mesh;
 pub mod raster;

@@ -9,6 +9,7 @@ pub mod color;
 pub mod fit;
 pub mod glyphs;
 pub mod locale;
+pub mod paint;
 pub mod shapes;
 
 pub use color::{ColorMode, Rgb};

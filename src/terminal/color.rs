@@ -175,14 +175,13 @@ fn nearest(palette: &[Rgb], c: Rgb) -> usize {
 /// ramp (232–255).
 #[must_use]
 pub fn nearest_256(c: Rgb) -> u8 {
-    const LEVELS: [u8; 6] = [0, 95, 135, 175, 215, 255];
     let level = |v: u8| {
         (0..6)
-            .min_by_key(|&i| (i32::from(LEVELS[i]) - i32::from(v)).abs())
+            .min_by_key(|&i| (i32::from(CUBE_LEVELS[i]) - i32::from(v)).abs())
             .unwrap_or(0)
     };
     let (r, g, b) = (level(c[0]), level(c[1]), level(c[2]));
-    let cube = [LEVELS[r], LEVELS[g], LEVELS[b]];
+    let cube = [CUBE_LEVELS[r], CUBE_LEVELS[g], CUBE_LEVELS[b]];
     let avg = (u32::from(c[0]) + u32::from(c[1]) + u32::from(c[2])) / 3;
     let gi = ((avg.saturating_sub(8)) / 10).min(23) as u8;
     let grey = 8 + 10 * gi;
@@ -190,6 +189,36 @@ pub fn nearest_256(c: Rgb) -> u8 {
         232 + gi
     } else {
         16 + 36 * r as u8 + 6 * g as u8 + b as u8
+    }
+}
+
+/// The six levels of each channel in the xterm 6×6×6 colour cube (indices 16–231).
+const CUBE_LEVELS: [u8; 6] = [0, 95, 135, 175, 215, 255];
+
+/// The RGB colour xterm shows for palette index `i`: the 16 ANSI colours, the 6×6×6
+/// cube (16–231) or the grey ramp `8 + 10k` (232–255). The inverse of
+/// [`nearest_256`], for painting what a terminal shows.
+#[must_use]
+pub fn indexed_rgb(i: u8) -> Rgb {
+    match i {
+        0..=15 => ANSI16_RGB[usize::from(i)],
+        16..=231 => {
+            let c = i - 16;
+            [c / 36, c / 6 % 6, c % 6].map(|l| CUBE_LEVELS[usize::from(l)])
+        }
+        _ => [8 + 10 * (i - 232); 3],
+    }
+}
+
+/// Linear light in `[0, 1]` (clamped) encoded with the sRGB transfer curve, in `[0, 1]`.
+#[must_use]
+#[inline]
+pub fn linear_to_srgb(v: f32) -> f32 {
+    let v = v.clamp(0.0, 1.0);
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
     }
 }
 
@@ -205,5 +234,53 @@ mod tests {
         assert_eq!(to_srgb(-1.0), 0);
         assert_eq!(to_srgb(2.0), 255);
         assert!((to_linear(128) - 0.2158).abs() < 1e-3);
+    }
+
+    #[test]
+    fn palette_indices_round_trip() {
+        // Every cube and grey-ramp entry is its own nearest colour (the 16 ANSI
+        // colours repeat some of them and are not searched by `nearest_256`).
+        for i in 16..=255u8 {
+            assert_eq!(nearest_256(indexed_rgb(i)), i, "index {i}");
+        }
+        assert_eq!(indexed_rgb(16), [0, 0, 0]);
+        assert_eq!(indexed_rgb(196), [255, 0, 0]);
+        assert_eq!(indexed_rgb(231), [255, 255, 255]);
+        assert_eq!(indexed_rgb(232), [8, 8, 8]);
+        assert_eq!(indexed_rgb(255), [238, 238, 238]);
+        assert_eq!(indexed_rgb(7), [229, 229, 229]);
+    }
+
+    #[test]
+    fn nearest_256_is_close() {
+        // The cube's widest gap is 95 (0 to 95), so its nearest entry is at most 47.5
+        // off per channel; the grey ramp is taken only when it is nearer still. Over a
+        // grid of colours the mean error stays small.
+        let mut total = 0i64;
+        let mut n = 0i64;
+        for r in (0..=255u8).step_by(15) {
+            for g in (0..=255u8).step_by(15) {
+                for b in (0..=255u8).step_by(15) {
+                    let c = [r, g, b];
+                    let got = indexed_rgb(nearest_256(c));
+                    let d = dist2(got, c);
+                    assert!(d <= 3 * 48 * 48, "{c:?} -> {got:?}");
+                    total += i64::from(d);
+                    n += 1;
+                }
+            }
+        }
+        let rms = ((total / n) as f64 / 3.0).sqrt();
+        assert!(rms < 20.0, "rms channel error {rms}");
+    }
+
+    #[test]
+    fn transfer_curve_round_trips() {
+        for v in 0..=255u8 {
+            assert_eq!((linear_to_srgb(to_linear(v)) * 255.0).round() as u8, v);
+        }
+        assert_eq!(to_linear(0), 0.0);
+        assert!((to_linear(255) - 1.0).abs() < 1e-6);
+        assert!((to_linear(188) - 0.5).abs() < 0.005);
     }
 }

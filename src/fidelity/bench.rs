@@ -1,0 +1,369 @@
+//! The benchmark's run: every glyph mode × colour depth of every view, and chafa's
+//! symbol sets on the same views, each through the emulator and painter and scored
+//! against the view's reference.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use image::RgbImage;
+
+use super::chafa::{Chafa, SYMBOL_SETS};
+use super::config::{Config, View, file_name};
+use super::metrics::{self, Score};
+use super::reference::{self, ReferenceImages};
+use super::{FidelityError, save_png};
+use crate::render::standard::{Model, StandardView};
+use crate::terminal::paint;
+use crate::terminal::{ColorMode, GlyphMode};
+use crate::tui::viewport::{ViewSettings, Viewport};
+
+/// Who drew the cells.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Source {
+    Termrast,
+    Chafa,
+}
+
+impl Source {
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Source::Termrast => "termrast",
+            Source::Chafa => "chafa",
+        }
+    }
+}
+
+/// One frame's scores.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measurement {
+    pub view: String,
+    pub source: Source,
+    /// termrast's glyph mode or chafa's symbol set.
+    pub method: String,
+    pub colors: ColorMode,
+    pub score: Score,
+    /// Bytes of the frame's output.
+    pub bytes: usize,
+    /// Cells whose character the painter does not know.
+    pub unpainted: usize,
+    /// The size in cells of what the bytes print (columns, rows).
+    pub printed: (u16, u16),
+}
+
+/// All measurements in view order, and notes on what was skipped or looked odd.
+#[derive(Clone, Debug, Default)]
+pub struct Outcome {
+    pub measurements: Vec<Measurement>,
+    pub notes: Vec<String>,
+}
+
+/// termrast's frame as the bytes a terminal receives: the one place the encoder is
+/// called, so a better one replaces it here.
+pub fn encode(vp: &Viewport) -> std::io::Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    crate::cli::view_cmd::write_ansi(vp, &mut bytes)?;
+    Ok(bytes)
+}
+
+/// Runs the benchmark: the views are shared out among the CPU's cores.
+pub fn run(config: &Config) -> Result<Outcome, FidelityError> {
+    config.check()?;
+    let mut models = HashMap::new();
+    for v in &config.views {
+        if !models.contains_key(&v.model) {
+            models.insert(v.model.clone(), crate::cli::view_cmd::load_model(&v.model)?);
+        }
+    }
+    if let Some(dir) = &config.keep {
+        std::fs::create_dir_all(dir).map_err(|e| FidelityError::Io(dir.clone(), e))?;
+    }
+    let mut notes = Vec::new();
+    let chafa = if config.chafa {
+        match Chafa::find() {
+            Ok(c) => {
+                notes.push(format!("compared with {}", c.version));
+                Some(c)
+            }
+            Err(e) => {
+                notes.push(format!("{e}: termrast rows only"));
+                None
+            }
+        }
+    } else {
+        notes.push("chafa not run (--no-chafa)".into());
+        None
+    };
+    let workers = std::thread::available_parallelism()
+        .map_or(1, usize::from)
+        .min(config.views.len());
+    let next = AtomicUsize::new(0);
+    let mut results: Vec<(usize, Result<Outcome, FidelityError>)> = Vec::new();
+    std::thread::scope(|s| {
+        let handles: Vec<_> = (0..workers)
+            .map(|_| {
+                s.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        let Some(view) = config.views.get(i) else {
+                            break done;
+                        };
+                        let model = &models[&view.model];
+                        done.push((i, measure_view(config, model, view, chafa.as_ref())));
+                    }
+                })
+            })
+            .collect();
+        for h in handles {
+            match h.join() {
+                Ok(done) => results.extend(done),
+                Err(_) => results.push((usize::MAX, Err(FidelityError::Worker))),
+            }
+        }
+    });
+    results.sort_by_key(|r| r.0);
+    let mut measurements = Vec::new();
+    for (_, r) in results {
+        let o = r?;
+        measurements.extend(o.measurements);
+        notes.extend(o.notes);
+    }
+    notes.extend(size_notes(config, &measurements));
+    Ok(Outcome {
+        measurements,
+        notes,
+    })
+}
+
+/// Notes on outputs that do not print exactly the grid's size (the emulator's
+/// screen is the grid's size, so a smaller output is padded with blank cells).
+fn size_notes(config: &Config, ms: &[Measurement]) -> Vec<String> {
+    let grid = (config.cols, config.rows);
+    let mut notes = Vec::new();
+    for source in [Source::Termrast, Source::Chafa] {
+        let of: Vec<_> = ms.iter().filter(|m| m.source == source).collect();
+        let off: Vec<_> = of.iter().filter(|m| m.printed != grid).collect();
+        if of.is_empty() {
+            continue;
+        }
+        if off.is_empty() {
+            notes.push(format!(
+                "every {} frame printed exactly {}×{} cells",
+                source.name(),
+                grid.0,
+                grid.1
+            ));
+        }
+        for m in off {
+            notes.push(format!(
+                "{} {} {} on {} printed {}×{} cells, not {}×{} (blank cells pad it)",
+                source.name(),
+                m.method,
+                m.colors.name(),
+                m.view,
+                m.printed.0,
+                m.printed.1,
+                grid.0,
+                grid.1
+            ));
+        }
+    }
+    notes
+}
+
+/// The reference of one camera, rendered and prepared for scoring.
+struct Prepared {
+    camera: StandardView,
+    images: ReferenceImages,
+    metric: metrics::Reference,
+}
+
+/// Scores one frame's bytes: emulated, painted and compared with the reference.
+fn measure(
+    config: &Config,
+    reference: &Prepared,
+    bytes: &[u8],
+    id: (&View, Source, &str, ColorMode),
+) -> Result<Measurement, FidelityError> {
+    let (view, source, method, colors) = id;
+    let grid = paint::emulate(bytes, config.cols, config.rows)?;
+    let painted = paint::paint(&grid)?;
+    let score = reference.metric.score(&painted.image)?;
+    if let Some(dir) = &config.keep {
+        let name = format!(
+            "{}-{}-{method}-{}",
+            view.name(),
+            source.name(),
+            colors.name()
+        );
+        save_png(&dir.join(file_name(&name)), &painted.image)?;
+    }
+    Ok(Measurement {
+        view: view.name(),
+        source,
+        method: method.to_owned(),
+        colors,
+        score,
+        bytes: bytes.len(),
+        unpainted: painted.unpainted,
+        printed: paint::printed_size(bytes, config.cols, config.rows)?,
+    })
+}
+
+/// Every termrast mode and colour depth of one view, then chafa's.
+fn measure_view(
+    config: &Config,
+    model: &Model,
+    view: &View,
+    chafa: Option<&Chafa>,
+) -> Result<Outcome, FidelityError> {
+    let (cols, rows) = (config.cols, config.rows);
+    let (w, h) = config.pixels();
+    let mut vp = Viewport::default();
+    let mut prepared: Option<Prepared> = None;
+    let mut out = Outcome::default();
+    for glyphs in GlyphMode::ALL {
+        for colors in ColorMode::ALL {
+            let settings = ViewSettings {
+                glyphs,
+                colors,
+                angle: view.angle,
+                tilt: view.tilt,
+                ..ViewSettings::default()
+            };
+            vp.render(model, &settings, cols, rows);
+            let camera = StandardView {
+                pixel_aspect: 1.0,
+                ..vp.view
+            };
+            let reference = match prepared.take() {
+                Some(p) if p.camera == camera => p,
+                old => {
+                    if old.is_some() {
+                        out.notes.push(format!(
+                            "{}: {} frames have a camera of their own; their reference \
+                             was rendered again",
+                            view.name(),
+                            glyphs.name()
+                        ));
+                    }
+                    let images = reference::render(model, &camera, &settings, w, h);
+                    if let Some(dir) = &config.keep {
+                        let name = format!("{}-reference", view.name());
+                        save_png(&dir.join(file_name(&name)), &images.image)?;
+                    }
+                    let metric = metrics::Reference::new(&images.image)?;
+                    Prepared {
+                        camera,
+                        images,
+                        metric,
+                    }
+                }
+            };
+            let bytes = encode(&vp).map_err(FidelityError::Encode)?;
+            let id = (view, Source::Termrast, glyphs.name(), colors);
+            out.measurements
+                .push(measure(config, &reference, &bytes, id)?);
+            prepared = Some(reference);
+        }
+    }
+    if let (Some(chafa), Some(reference)) = (chafa, &prepared) {
+        measure_chafa(config, chafa, reference, view, &mut out)?;
+    }
+    Ok(out)
+}
+
+/// A PNG for chafa to read: in the keep directory, or a temporary file removed on drop.
+struct ChafaInput {
+    path: PathBuf,
+    temporary: bool,
+}
+
+impl ChafaInput {
+    fn write(config: &Config, view: &View, img: &RgbImage) -> Result<Self, FidelityError> {
+        let (path, temporary) = match &config.keep {
+            Some(dir) => (
+                dir.join(file_name(&format!("{}-reference-full", view.name()))),
+                false,
+            ),
+            None => {
+                let name = format!("termrast-fidelity-{}-{}", std::process::id(), view.name());
+                (std::env::temp_dir().join(file_name(&name)), true)
+            }
+        };
+        save_png(&path, img)?;
+        Ok(Self { path, temporary })
+    }
+}
+
+impl Drop for ChafaInput {
+    fn drop(&mut self) {
+        if self.temporary {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
+}
+
+/// chafa's symbol sets at every colour depth on one view; a failed conversion is a
+/// note, not an error.
+fn measure_chafa(
+    config: &Config,
+    chafa: &Chafa,
+    reference: &Prepared,
+    view: &View,
+    out: &mut Outcome,
+) -> Result<(), FidelityError> {
+    let input = match ChafaInput::write(config, view, &reference.images.full) {
+        Ok(i) => i,
+        Err(e) if config.keep.is_none() => {
+            out.notes
+                .push(format!("{}: no chafa rows: {e}", view.name()));
+            return Ok(());
+        }
+        Err(e) => return Err(e),
+    };
+    for set in SYMBOL_SETS {
+        for colors in ColorMode::ALL {
+            match chafa.convert(&input.path, config.cols, config.rows, set, colors) {
+                Ok(bytes) => {
+                    let id = (view, Source::Chafa, set, colors);
+                    out.measurements
+                        .push(measure(config, reference, &bytes, id)?);
+                }
+                Err(e) => out.notes.push(format!("{}: {e}", view.name())),
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fidelity::config::standard_views;
+
+    #[test]
+    fn a_tiny_run_gives_sane_rows() {
+        let views = vec![standard_views(true).remove(0)];
+        let mut config = Config::new(20, 8, views).unwrap();
+        config.chafa = false;
+        let o = run(&config).unwrap();
+        let n = GlyphMode::ALL.len() * ColorMode::ALL.len();
+        assert_eq!(o.measurements.len(), n);
+        for m in &o.measurements {
+            let s = m.score.ssim;
+            assert!(s > 0.0 && s <= 1.0, "{m:?}");
+            assert!(
+                m.bytes > 0 && m.printed.0 <= 20 && m.printed.1 <= 8,
+                "{m:?}"
+            );
+            assert_eq!(m.unpainted, 0, "{m:?}");
+            if m.colors == ColorMode::Truecolor {
+                assert!(s > 0.3, "{m:?}");
+            }
+        }
+        assert!(o.notes.iter().any(|n| n.contains("--no-chafa")));
+    }
+}

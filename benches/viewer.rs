@@ -22,7 +22,8 @@ fn bench(c: &mut Criterion) {
             (GlyphMode::Braille, ColorMode::Truecolor),
             (GlyphMode::Braille, ColorMode::Ansi256),
             (GlyphMode::Blocks, ColorMode::Truecolor),
-            (GlyphMode::Blocks, ColorMode::Ansi256),
+            (GlyphMode::Wedges, ColorMode::Truecolor),
+            (GlyphMode::Wedges, ColorMode::Ansi256),
             (GlyphMode::Ascii, ColorMode::Truecolor),
         ] {
             let settings = ViewSettings {

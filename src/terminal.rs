@@ -5,12 +5,15 @@
 //! samples. Cells are about twice as tall as wide (`cell_aspect` = width / height ≈
 //! 0.5), so a sample's aspect is `cell_aspect · sy / sx`.
 
+pub mod ansi;
 pub mod color;
 pub mod fit;
 pub mod glyphs;
 pub mod locale;
 pub mod paint;
+mod shaped;
 pub mod shapes;
+mod split;
 
 pub use color::{ColorMode, Rgb};
 pub use glyphs::{CellGlyph, GlyphMode};

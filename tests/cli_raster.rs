@@ -111,21 +111,38 @@ fn the_viewer_refuses_a_pipe_and_suggests_render() {
 
 #[test]
 fn render_writes_text_frames() {
-    let (ok, out, err) = termrast(&[
-        "render", "--cols", "40", "--rows", "12", "--color", "none", "--frames", "2",
-    ]);
-    assert!(ok, "{err}");
-    let frames: Vec<&str> = out.split("\n\n").collect();
-    assert_eq!(frames.len(), 2, "frames are separated by a blank line");
-    for f in frames {
-        let lines: Vec<&str> = f.trim_end_matches('\n').split('\n').collect();
-        assert_eq!(lines.len(), 12);
-        assert!(lines.iter().all(|l| l.chars().count() == 40));
-        let dots = f
-            .chars()
-            .filter(|c| ('\u{2801}'..='\u{28FF}').contains(c))
-            .count();
-        assert!(dots > 50, "the teapot is drawn in braille:\n{f}");
+    for (glyphs, is_ink) in [
+        (
+            "braille",
+            (|c| ('\u{2801}'..='\u{28FF}').contains(&c) || "░▒▓█".contains(c)) as fn(char) -> bool,
+        ),
+        ("blocks", |c| {
+            ('\u{2580}'..='\u{259F}').contains(&c) || c >= '\u{1FB00}'
+        }),
+    ] {
+        let (ok, out, err) = termrast(&[
+            "render", "--cols", "40", "--rows", "12", "--color", "none", "--frames", "2",
+            "--glyphs", glyphs,
+        ]);
+        assert!(ok, "{err}");
+        // Each frame is 12 lines (trailing blank cells are not written), then a blank
+        // line between frames.
+        let lines: Vec<&str> = out.strip_suffix('\n').unwrap_or(&out).split('\n').collect();
+        assert_eq!(lines.len(), 2 * 12 + 1, "{out}");
+        assert_eq!(lines[12], "", "frames are separated by a blank line");
+        for f in [&lines[..12], &lines[13..]] {
+            assert!(f.iter().all(|l| l.chars().count() <= 40));
+            let ink = f
+                .iter()
+                .flat_map(|l| l.chars())
+                .filter(|&c| is_ink(c))
+                .count();
+            assert!(
+                ink > 50,
+                "the teapot is drawn in {glyphs}:\n{}",
+                f.join("\n")
+            );
+        }
     }
     let (ok, out, _) = termrast(&[
         "render",

@@ -6,8 +6,8 @@ use termrast::cli::view_cmd::write_ansi;
 use termrast::scene::Scene;
 use termrast::scene::render::SceneFrame;
 use termrast::terminal::color::{to_linear, to_srgb};
-use termrast::terminal::fit::{self, N, Repertoire, mask_of};
-use termrast::terminal::glyphs::{Sample, fit_cell};
+use termrast::terminal::fit::{self, N, Repertoire, mask_of, weights_of};
+use termrast::terminal::glyphs::{FitSpace, Sample, fit_cell};
 use termrast::terminal::{ColorMode, GlyphMode};
 use termrast::tui::viewport::{ViewSettings, Viewport};
 
@@ -31,30 +31,42 @@ fn block_glyphs() -> Vec<char> {
     v
 }
 
-/// The least squared error of any glyph of `glyphs` with the best two colours for it
-/// (the means of its two sides), in f64.
+/// The least squared error of any glyph of `glyphs` drawn in the best two colours for
+/// it, each sample seen as its box's mix `b + α(f − b)`: per channel, least squares
+/// over `b` and `f − b`, solved directly in f64.
 fn brute_force(glyphs: &[char], x: &[[f32; 3]; N]) -> f64 {
-    let sse = |idx: &mut dyn Iterator<Item = usize>| {
-        let v: Vec<[f64; 3]> = idx.map(|i| x[i].map(f64::from)).collect();
-        if v.is_empty() {
-            return 0.0;
-        }
-        let n = v.len() as f64;
+    let uniform = {
         (0..3)
             .map(|c| {
-                let m = v.iter().map(|p| p[c]).sum::<f64>() / n;
-                v.iter().map(|p| (p[c] - m).powi(2)).sum::<f64>()
+                let m = x.iter().map(|p| f64::from(p[c])).sum::<f64>() / N as f64;
+                x.iter().map(|p| (f64::from(p[c]) - m).powi(2)).sum::<f64>()
             })
-            .sum()
+            .sum::<f64>()
     };
     glyphs
         .iter()
-        .map(|&ch| {
-            let m = mask_of(ch).expect("a known glyph");
-            sse(&mut (0..N).filter(|i| m >> i & 1 == 1))
-                + sse(&mut (0..N).filter(|i| m >> i & 1 == 0))
+        .filter_map(|&ch| {
+            let w = weights_of(ch).expect("a known glyph").map(f64::from);
+            let (n, a, b) = (
+                N as f64,
+                w.iter().sum::<f64>(),
+                w.iter().map(|v| v * v).sum::<f64>(),
+            );
+            let det = n * b - a * a;
+            (det > 1e-3).then(|| {
+                (0..3)
+                    .map(|c| {
+                        let xs = x.map(|p| f64::from(p[c]));
+                        let sx: f64 = xs.iter().sum();
+                        let sy: f64 = (0..N).map(|i| w[i] * xs[i]).sum();
+                        let bg = (b * sx - a * sy) / det;
+                        let d = (n * sy - a * sx) / det;
+                        (0..N).map(|i| (xs[i] - bg - w[i] * d).powi(2)).sum::<f64>()
+                    })
+                    .sum::<f64>()
+            })
         })
-        .fold(f64::INFINITY, f64::min)
+        .fold(uniform, f64::min)
 }
 
 fn samples_strategy() -> impl Strategy<Value = [[f32; 3]; N]> {
@@ -83,14 +95,27 @@ proptest! {
 
     #[test]
     fn block_fit_is_the_brute_force_optimum(x in samples_strategy()) {
-        let f = fit::fit(Repertoire::blocks(), &x);
+        let f = fit::fit(Repertoire::wedges(), &x);
         let want = brute_force(&block_glyphs(), &x);
+        let f2 = fit::fit(Repertoire::blocks(), &x);
+        let no_wedges: Vec<char> = block_glyphs().into_iter().filter(|c| !('\u{1FB3C}'..='\u{1FB6F}').contains(c)).collect();
+        let want2 = brute_force(&no_wedges, &x);
+        prop_assert!((f64::from(f2.error) - want2).abs() <= 1e-4 * (1.0 + want2), "{} vs {want2}", f2.error);
         prop_assert!((f64::from(f.error) - want).abs() <= 1e-4 * (1.0 + want), "{} vs {want}", f.error);
-        // The colours are the means of the two sides of the chosen shape.
+        // The colours are the fit's: the error of drawing the glyph in them is the
+        // reported one (up to clamping to [0, 1], which only adds error).
         if let Some(sh) = f.shape {
-            let on = (0..N).filter(|i| sh.mask >> i & 1 == 1).count() as f32;
-            let r: f32 = (0..N).filter(|i| sh.mask >> i & 1 == 1).map(|i| x[i][0]).sum();
-            prop_assert!((f.on[0] - r / on).abs() < 1e-5);
+            let e: f64 = (0..N)
+                .map(|i| {
+                    (0..3)
+                        .map(|c| {
+                            let seen = f.off[c] + sh.weights[i] * (f.on[c] - f.off[c]);
+                            f64::from(x[i][c] - seen).powi(2)
+                        })
+                        .sum::<f64>()
+                })
+                .sum();
+            prop_assert!(e + 1e-3 >= f64::from(f.error), "{e} < {}", f.error);
         }
     }
 
@@ -112,7 +137,7 @@ proptest! {
                 Sample { rgb: if covered { x[i].map(to_srgb) } else { [0; 3] }, covered }
             })
             .collect();
-        let g = fit_cell(GlyphMode::Blocks, &samples, ColorMode::Truecolor);
+        let g = fit_cell(GlyphMode::Wedges, &samples, ColorMode::Truecolor, FitSpace::Srgb);
         if cover == 0 {
             prop_assert_eq!((g.ch, g.fg, g.bg), (' ', None, None));
             return Ok(());
@@ -122,15 +147,18 @@ proptest! {
             prop_assert!(g.fg.is_none() && g.bg.is_some());
         } else {
             prop_assert!(g.fg.is_some());
-            let off_covered = (0..N).any(|i| g.pattern >> i & 1 == 0 && samples[i].covered);
-            prop_assert_eq!(g.bg.is_some(), off_covered);
+            // The terminal's own background shows only where no covered sample is.
+            let w = weights_of(g.ch).unwrap();
+            if g.bg.is_none() {
+                prop_assert!((0..N).all(|i| !samples[i].covered || w[i] == 1.0));
+            }
         }
     }
 }
 
 #[test]
 fn every_listed_glyph_is_in_the_repertoire() {
-    let rep = Repertoire::blocks();
+    let rep = Repertoire::wedges();
     for ch in block_glyphs() {
         let m = mask_of(ch).unwrap();
         if m == 0 || m == fit::FULL {
@@ -162,6 +190,7 @@ fn braille_dots_go_on_the_smaller_group() {
         GlyphMode::Braille,
         &[w, w, w, w, w, w, w, d],
         ColorMode::Truecolor,
+        FitSpace::Srgb,
     );
     assert_eq!((g.ch, g.fg, g.bg), ('⢀', Some([30; 3]), Some([240; 3])));
     // A bright edge over the empty background: the covered samples stay dots whenever
@@ -171,6 +200,7 @@ fn braille_dots_go_on_the_smaller_group() {
         GlyphMode::Braille,
         &[w, off, w, off, off, off, off, off],
         ColorMode::Truecolor,
+        FitSpace::Srgb,
     );
     assert_eq!((g.fg, g.bg), (Some([240; 3]), None));
 }

@@ -4,7 +4,7 @@ use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 use termrast::render::standard::Model;
 use termrast::render::wire::Mode;
-use termrast::terminal::glyphs::{Sample, braille, fit_cell, sextant};
+use termrast::terminal::glyphs::{FitSpace, Sample, braille, fit_cell, sextant};
 use termrast::terminal::{ColorMode, GlyphMode};
 use termrast::tui::app::App;
 use termrast::tui::inspector::{inspector_text, line_at, line_text};
@@ -24,15 +24,27 @@ fn half_block_uses_top_as_foreground() {
         GlyphMode::Half,
         &[s([200, 10, 10]), s([10, 10, 200])],
         ColorMode::Truecolor,
+        FitSpace::Srgb,
     );
     assert_eq!(
         (g.ch, g.fg, g.bg),
         ('▀', Some([200, 10, 10]), Some([10, 10, 200]))
     );
-    let g = fit_cell(GlyphMode::Half, &[OFF, s([9, 9, 9])], ColorMode::Truecolor);
+    let g = fit_cell(
+        GlyphMode::Half,
+        &[OFF, s([9, 9, 9])],
+        ColorMode::Truecolor,
+        FitSpace::Srgb,
+    );
     assert_eq!((g.ch, g.fg, g.bg), ('▄', Some([9, 9, 9]), None));
     assert_eq!(
-        fit_cell(GlyphMode::Half, &[OFF, OFF], ColorMode::Truecolor).ch,
+        fit_cell(
+            GlyphMode::Half,
+            &[OFF, OFF],
+            ColorMode::Truecolor,
+            FitSpace::Srgb
+        )
+        .ch,
         ' '
     );
 }
@@ -42,7 +54,12 @@ fn quadrant_fit_picks_the_bright_half() {
     // Top half bright, bottom half dark → upper half block, two colours.
     let w = s([250, 250, 250]);
     let d = s([20, 20, 20]);
-    let g = fit_cell(GlyphMode::Quadrant, &[w, w, d, d], ColorMode::Truecolor);
+    let g = fit_cell(
+        GlyphMode::Quadrant,
+        &[w, w, d, d],
+        ColorMode::Truecolor,
+        FitSpace::Srgb,
+    );
     assert_eq!(
         (g.ch, g.fg, g.bg, g.error),
         ('▀', Some([250; 3]), Some([20; 3]), 0.0)
@@ -52,10 +69,16 @@ fn quadrant_fit_picks_the_bright_half() {
         GlyphMode::Quadrant,
         &[OFF, OFF, OFF, w],
         ColorMode::Truecolor,
+        FitSpace::Srgb,
     );
     assert_eq!((g.ch, g.bg), ('▗', None));
     // One colour is a space on that background.
-    let g = fit_cell(GlyphMode::Quadrant, &[w, w, w, w], ColorMode::Truecolor);
+    let g = fit_cell(
+        GlyphMode::Quadrant,
+        &[w, w, w, w],
+        ColorMode::Truecolor,
+        FitSpace::Srgb,
+    );
     assert_eq!((g.ch, g.bg), (' ', Some([250; 3])));
 }
 
@@ -84,20 +107,32 @@ fn braille_and_sextant_bit_layouts() {
 fn colorless_modes_dither_by_luminance() {
     let grey = |v: u8| s([v, v, v]);
     // Uniform cells are shades: no braille dots over the default background.
-    let uniform = |v| fit_cell(GlyphMode::Braille, &[grey(v); 8], ColorMode::None).ch;
+    let uniform = |v| {
+        fit_cell(
+            GlyphMode::Braille,
+            &[grey(v); 8],
+            ColorMode::None,
+            FitSpace::Srgb,
+        )
+        .ch
+    };
     assert_eq!(uniform(0), ' ');
-    assert_eq!(uniform(128), '▒');
+    assert_eq!(uniform(128), '░');
+    assert_eq!(uniform(200), '▓');
     assert_eq!(uniform(255), '█');
     // Other cells dither: more dots for brighter samples.
-    let dots = |v: u8| {
+    let cell = |v: u8| {
         let mut c = [grey(v); 8];
         c[0] = grey(v.saturating_sub(1));
-        let g = fit_cell(GlyphMode::Braille, &c, ColorMode::None);
+        let g = fit_cell(GlyphMode::Braille, &c, ColorMode::None, FitSpace::Srgb);
         assert_eq!((g.fg, g.bg), (None, None));
-        g.pattern.count_ones()
+        g
     };
+    let dots = |v: u8| cell(v).pattern.count_ones();
     assert_eq!(dots(1), 0);
-    assert!(dots(64) < dots(128) && dots(128) < dots(200));
+    assert!(dots(32) < dots(64) && dots(64) < dots(128));
+    // Brighter than every dot lit can show (a third of the cell): a shade instead.
+    assert_eq!((cell(200).ch, cell(200).pattern), ('▓', 0));
 }
 
 #[test]
@@ -269,7 +304,7 @@ mod fit_property {
                 if s.iter().all(|x| !x.covered) {
                     continue;
                 }
-                let g = fit_cell(mode, s, ColorMode::Truecolor);
+                let g = fit_cell(mode, s, ColorMode::Truecolor, FitSpace::Srgb);
                 // Integer error with the mean's remainder truncated: within n of exact.
                 let want = best_error(s);
                 prop_assert!((f64::from(g.error) - want).abs() <= n as f64 + 1e-6, "{} vs {}", g.error, want);

@@ -22,6 +22,7 @@ impl Tmux {
         };
         let ok = t
             .run(&[
+                "-u",
                 "new-session",
                 "-d",
                 "-s",
@@ -86,8 +87,13 @@ impl Tmux {
     }
 
     fn start_viewer(&self) {
+        self.start_viewer_with("TERM=xterm-256color LANG=C.UTF-8", "");
+    }
+
+    /// Starts the viewer with environment assignments `env` and arguments `args`.
+    fn start_viewer_with(&self, env: &str, args: &str) {
         let cmd = format!(
-            "TERM=xterm-256color {} ; echo EXIT=$?",
+            "{env} {} {args}; echo EXIT=$?",
             env!("CARGO_BIN_EXE_termrast")
         );
         self.keys(&["clear", "Enter", &cmd, "Enter"]);
@@ -158,4 +164,48 @@ fn sigterm_restores_the_terminal() {
         .status();
     assert!(out.is_ok_and(|s| s.success()), "pkill found the viewer");
     t.assert_restored();
+}
+
+#[test]
+fn a_non_utf8_locale_falls_back_to_ascii_and_says_so() {
+    let Some(t) = Tmux::new("locale") else {
+        eprintln!("tmux not installed: skipping the terminal end-to-end test");
+        return;
+    };
+    t.start_viewer_with("TERM=xterm-256color LANG=C LC_ALL=C", "");
+    let s = t.wait_for("not UTF-8");
+    assert!(
+        s.contains("locale C is not UTF-8: ascii glyphs"),
+        "no notice:\n{s}"
+    );
+    let status = s.lines().rfind(|l| l.contains("fps |")).unwrap_or_default();
+    assert!(status.contains("ascii"), "not ascii:\n{status}");
+    // Nothing outside ASCII reaches the screen.
+    assert!(s.is_ascii(), "non-ASCII glyphs on screen:\n{s}");
+    // The notice is said once: a key clears it.
+    t.keys(&["g"]);
+    sleep(Duration::from_millis(300));
+    assert!(!t.screen().contains("not UTF-8"));
+    t.keys(&["q"]);
+    t.assert_restored();
+}
+
+#[test]
+fn a_dumb_terminal_gets_a_message_not_a_full_screen_interface() {
+    let Some(t) = Tmux::new("dumb") else {
+        eprintln!("tmux not installed: skipping the terminal end-to-end test");
+        return;
+    };
+    let cmd = format!(
+        "TERM=dumb {} ; echo EXIT=$?",
+        env!("CARGO_BIN_EXE_termrast")
+    );
+    t.keys(&["clear", "Enter", &cmd, "Enter"]);
+    let s = t.wait_for("EXIT=");
+    assert!(
+        s.contains("TERM=dumb") && s.contains("termrast render"),
+        "{s}"
+    );
+    assert!(s.contains("EXIT=1"), "{s}");
+    assert_eq!(t.flags(), "0 0 1", "the terminal was left as it was");
 }

@@ -205,7 +205,13 @@ fn text_frames(
         } else if n > 0 {
             out.write_all(b"\n")?;
         }
-        super::view_cmd::write_ansi(&vp, &mut out)?;
+        crate::terminal::ansi::write_frame(
+            &vp.cells,
+            usize::from(vp.cols),
+            vp.settings.colors,
+            args.animate,
+            &mut out,
+        )?;
     }
     out.flush()?;
     Ok(())

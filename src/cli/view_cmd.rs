@@ -7,6 +7,7 @@ use clap::Args;
 use crate::mesh::Mesh;
 use crate::render::standard::Model;
 use crate::render::wire::Mode;
+use crate::terminal::glyphs::FitSpace;
 use crate::terminal::{ColorMode, GlyphMode, locale};
 use crate::tui::app::App;
 use crate::tui::viewport::{ViewSettings, Viewport};
@@ -21,6 +22,9 @@ pub struct LookArgs {
     /// Colour depth; detected from NO_COLOR, COLORTERM and TERM when not given.
     #[arg(long, value_enum)]
     pub color: Option<ColorMode>,
+    /// Where the shape-fitted glyph modes (blocks, ascii) measure colour error.
+    #[arg(long, value_enum, default_value_t = FitSpace::Srgb)]
+    pub fit_space: FitSpace,
     /// Cell width / height (terminal cells are about twice as tall as wide).
     #[arg(long, default_value_t = 0.5, value_parser = parse_aspect)]
     pub cell_aspect: f32,
@@ -55,13 +59,14 @@ impl LookArgs {
         let glyphs = match self.glyphs {
             Some(g) => g,
             None if !utf8 => GlyphMode::Ascii,
-            None => GlyphMode::default_for(colors),
+            None => GlyphMode::default_for(locale::draws_wedges(&get)),
         };
         ViewSettings {
             glyphs,
             colors,
             mode,
             cell_aspect: self.cell_aspect,
+            fit_space: self.fit_space,
             cull,
             ..ViewSettings::default()
         }
@@ -126,69 +131,13 @@ pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
     Ok(())
 }
 
-fn sgr(c: ratatui::style::Color, fg: bool) -> String {
-    use ratatui::style::Color as C;
-    let base = if fg { 30 } else { 40 };
-    match c {
-        C::Rgb(r, g, b) => format!("{};2;{r};{g};{b}", base + 8),
-        C::Indexed(n) => format!("{};5;{n}", base + 8),
-        C::Reset => format!("{}", base + 9),
-        named => {
-            let order = [
-                C::Black,
-                C::Red,
-                C::Green,
-                C::Yellow,
-                C::Blue,
-                C::Magenta,
-                C::Cyan,
-                C::Gray,
-                C::DarkGray,
-                C::LightRed,
-                C::LightGreen,
-                C::LightYellow,
-                C::LightBlue,
-                C::LightMagenta,
-                C::LightCyan,
-                C::White,
-            ];
-            let i = order.iter().position(|x| *x == named).unwrap_or(7) as u16;
-            let code = if i < 8 { base + i } else { base + 60 + i - 8 };
-            code.to_string()
-        }
-    }
-}
-
-/// Writes the viewport's cells as ANSI text: colours as SGR sequences only where they
-/// change, a reset at the end of each line.
+/// Writes the viewport's cells as ANSI text (see [`crate::terminal::ansi`]).
 pub fn write_ansi(vp: &Viewport, out: &mut impl Write) -> io::Result<()> {
-    let mode = vp.settings.colors;
-    let to = |c: Option<[u8; 3]>| match (c, mode) {
-        (Some(c), m) if m != ColorMode::None => m.color(c),
-        _ => ratatui::style::Color::Reset,
-    };
-    let mut line = String::new();
-    for cy in 0..vp.rows {
-        line.clear();
-        let mut cur = (ratatui::style::Color::Reset, ratatui::style::Color::Reset);
-        for cx in 0..vp.cols {
-            let Some(g) = vp.cell(cx, cy) else { continue };
-            let want = (to(g.fg), to(g.bg));
-            if want != cur && mode != ColorMode::None {
-                line.push_str(&format!(
-                    "\x1b[{};{}m",
-                    sgr(want.0, true),
-                    sgr(want.1, false)
-                ));
-                cur = want;
-            }
-            line.push(g.ch);
-        }
-        if mode != ColorMode::None {
-            line.push_str("\x1b[0m");
-        }
-        line.push('\n');
-        out.write_all(line.as_bytes())?;
-    }
-    Ok(())
+    crate::terminal::ansi::write_frame(
+        &vp.cells,
+        usize::from(vp.cols),
+        vp.settings.colors,
+        false,
+        out,
+    )
 }

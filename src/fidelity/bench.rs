@@ -14,6 +14,7 @@ use super::metrics::{self, Score};
 use super::reference::{self, ReferenceImages};
 use super::{FidelityError, save_png};
 use crate::render::standard::{Model, StandardView};
+use crate::terminal::glyphs::FitSpace;
 use crate::terminal::paint;
 use crate::terminal::{ColorMode, GlyphMode};
 use crate::tui::viewport::{ViewSettings, Viewport};
@@ -63,7 +64,13 @@ pub struct Outcome {
 /// called, so a better one replaces it here.
 pub fn encode(vp: &Viewport) -> std::io::Result<Vec<u8>> {
     let mut bytes = Vec::new();
-    crate::cli::view_cmd::write_ansi(vp, &mut bytes)?;
+    crate::terminal::ansi::write_frame(
+        &vp.cells,
+        usize::from(vp.cols),
+        vp.settings.colors,
+        false,
+        &mut bytes,
+    )?;
     Ok(bytes)
 }
 
@@ -139,22 +146,32 @@ pub fn run(config: &Config) -> Result<Outcome, FidelityError> {
 
 /// Notes on outputs that do not print exactly the grid's size (the emulator's
 /// screen is the grid's size, so a smaller output is padded with blank cells).
+/// termrast leaves trailing blank cells unwritten by design, so only a frame that
+/// prints beyond the grid is noted for it.
 fn size_notes(config: &Config, ms: &[Measurement]) -> Vec<String> {
     let grid = (config.cols, config.rows);
     let mut notes = Vec::new();
     for source in [Source::Termrast, Source::Chafa] {
         let of: Vec<_> = ms.iter().filter(|m| m.source == source).collect();
-        let off: Vec<_> = of.iter().filter(|m| m.printed != grid).collect();
+        let wrong = |m: &&&Measurement| match source {
+            Source::Termrast => m.printed.0 > grid.0 || m.printed.1 > grid.1,
+            Source::Chafa => m.printed != grid,
+        };
+        let off: Vec<_> = of.iter().filter(wrong).collect();
         if of.is_empty() {
             continue;
         }
         if off.is_empty() {
-            notes.push(format!(
-                "every {} frame printed exactly {}×{} cells",
-                source.name(),
-                grid.0,
-                grid.1
-            ));
+            notes.push(match source {
+                Source::Termrast => format!(
+                    "no termrast frame printed beyond {}×{} cells (trailing blank cells are left unwritten)",
+                    grid.0, grid.1
+                ),
+                Source::Chafa => format!(
+                    "every chafa frame printed exactly {}×{} cells",
+                    grid.0, grid.1
+                ),
+            });
         }
         for m in off {
             notes.push(format!(
@@ -213,6 +230,19 @@ fn measure(
 }
 
 /// Every termrast mode and colour depth of one view, then chafa's.
+/// Every mode as the viewer draws it, and the shape-fitted ones with their error
+/// measured in linear light too (what that choice costs).
+fn variants() -> impl Iterator<Item = (GlyphMode, FitSpace)> {
+    GlyphMode::ALL
+        .map(|g| (g, FitSpace::Srgb))
+        .into_iter()
+        .chain([
+            (GlyphMode::Ascii, FitSpace::Linear),
+            (GlyphMode::Blocks, FitSpace::Linear),
+            (GlyphMode::Wedges, FitSpace::Linear),
+        ])
+}
+
 fn measure_view(
     config: &Config,
     model: &Model,
@@ -224,13 +254,18 @@ fn measure_view(
     let mut vp = Viewport::default();
     let mut prepared: Option<Prepared> = None;
     let mut out = Outcome::default();
-    for glyphs in GlyphMode::ALL {
+    for (glyphs, fit_space) in variants() {
+        let method = match fit_space {
+            FitSpace::Srgb => glyphs.name().to_string(),
+            FitSpace::Linear => format!("{}-linear", glyphs.name()),
+        };
         for colors in ColorMode::ALL {
             let settings = ViewSettings {
                 glyphs,
                 colors,
                 angle: view.angle,
                 tilt: view.tilt,
+                fit_space,
                 ..ViewSettings::default()
             };
             vp.render(model, &settings, cols, rows);
@@ -263,7 +298,7 @@ fn measure_view(
                 }
             };
             let bytes = encode(&vp).map_err(FidelityError::Encode)?;
-            let id = (view, Source::Termrast, glyphs.name(), colors);
+            let id = (view, Source::Termrast, method.as_str(), colors);
             out.measurements
                 .push(measure(config, &reference, &bytes, id)?);
             prepared = Some(reference);
@@ -350,7 +385,7 @@ mod tests {
         let mut config = Config::new(20, 8, views).unwrap();
         config.chafa = false;
         let o = run(&config).unwrap();
-        let n = GlyphMode::ALL.len() * ColorMode::ALL.len();
+        let n = variants().count() * ColorMode::ALL.len();
         assert_eq!(o.measurements.len(), n);
         for m in &o.measurements {
             let s = m.score.ssim;

@@ -175,11 +175,7 @@ fn nearest(palette: &[Rgb], c: Rgb) -> usize {
 /// ramp (232–255).
 #[must_use]
 pub fn nearest_256(c: Rgb) -> u8 {
-    let level = |v: u8| {
-        (0..6)
-            .min_by_key(|&i| (i32::from(CUBE_LEVELS[i]) - i32::from(v)).abs())
-            .unwrap_or(0)
-    };
+    let level = |v: u8| usize::from(CUBE_LEVEL_OF[usize::from(v)]);
     let (r, g, b) = (level(c[0]), level(c[1]), level(c[2]));
     let cube = [CUBE_LEVELS[r], CUBE_LEVELS[g], CUBE_LEVELS[b]];
     let avg = (u32::from(c[0]) + u32::from(c[1]) + u32::from(c[2])) / 3;
@@ -194,6 +190,28 @@ pub fn nearest_256(c: Rgb) -> u8 {
 
 /// The six levels of each channel in the xterm 6×6×6 colour cube (indices 16–231).
 const CUBE_LEVELS: [u8; 6] = [0, 95, 135, 175, 215, 255];
+
+/// The cube level nearest each channel value (the lower one on a tie): a table, since
+/// the 256-colour mode quantises two colours of every cell.
+const CUBE_LEVEL_OF: [u8; 256] = {
+    let mut t = [0u8; 256];
+    let mut v = 0;
+    while v < 256 {
+        let mut best = 0;
+        let mut i = 1;
+        while i < 6 {
+            if (CUBE_LEVELS[i] as i32 - v as i32).abs()
+                < (CUBE_LEVELS[best] as i32 - v as i32).abs()
+            {
+                best = i;
+            }
+            i += 1;
+        }
+        t[v] = best as u8;
+        v += 1;
+    }
+    t
+};
 
 /// The RGB colour xterm shows for palette index `i`: the 16 ANSI colours, the 6×6×6
 /// cube (16–231) or the grey ramp `8 + 10k` (232–255). The inverse of

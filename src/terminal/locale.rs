@@ -19,6 +19,24 @@ pub fn is_utf8(locale: Option<&str>) -> bool {
     })
 }
 
+/// Whether the terminal is one known to draw the Unicode 13 legacy computing wedges
+/// itself (so no font can lack them): kitty, foot, Ghostty, WezTerm, Contour. `TERM`
+/// survives SSH; `TERM_PROGRAM` is checked too, for local sessions.
+pub fn draws_wedges(get: impl Fn(&str) -> Option<String>) -> bool {
+    let term = get("TERM").unwrap_or_default();
+    let program = get("TERM_PROGRAM").unwrap_or_default();
+    [
+        "xterm-kitty",
+        "foot",
+        "foot-extra",
+        "xterm-ghostty",
+        "wezterm",
+        "contour",
+    ]
+    .contains(&term.as_str())
+        || ["WezTerm", "ghostty", "contour"].contains(&program.as_str())
+}
+
 /// Why the viewer cannot draw a full-screen interface on this terminal, if it cannot.
 #[must_use]
 pub fn no_full_screen(term: Option<&str>) -> Option<String> {
@@ -60,6 +78,17 @@ mod tests {
         for (vars, want) in cases {
             assert_eq!(is_utf8(locale(env(vars)).as_deref()), *want, "{vars:?}");
         }
+    }
+
+    #[test]
+    fn terminals_that_draw_wedges_are_recognised() {
+        assert!(draws_wedges(env(&[("TERM", "xterm-kitty")])));
+        assert!(draws_wedges(env(&[
+            ("TERM", "xterm-256color"),
+            ("TERM_PROGRAM", "WezTerm")
+        ])));
+        assert!(!draws_wedges(env(&[("TERM", "xterm-256color")])));
+        assert!(!draws_wedges(env(&[])));
     }
 
     #[test]

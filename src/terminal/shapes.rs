@@ -155,7 +155,7 @@ pub fn ink(ch: char, x: f32, y: f32) -> Option<f32> {
             b(p >> bit & 1 == 1)
         }
         0x1FB3C..=0x1FB67 => b(wedge_ink(WEDGES[(c - 0x1FB3C) as usize], x, y)),
-        0x1FB68..=0x1FB6F => {
+        0x1FB68..=0x1FB6F | 0x1FB9A | 0x1FB9B => {
             // The triangles from each side to the centre: left, upper, right, lower.
             let tri = [
                 x < y && x < 1.0 - y,
@@ -165,6 +165,13 @@ pub fn ink(ch: char, x: f32, y: f32) -> Option<f32> {
             ];
             // U+1FB68…6B are three quarters: all but the left, upper, right or lower
             // one (UPPER AND RIGHT AND LOWER is all but the left); U+1FB6C…6F one.
+            // U+1FB9A and 9B are two opposite ones: upper and lower, left and right.
+            if c == 0x1FB9A {
+                return b(tri[1] || tri[3]);
+            }
+            if c == 0x1FB9B {
+                return b(tri[0] || tri[2]);
+            }
             let k = (c - 0x1FB68) as usize;
             if k < 4 { b(!tri[k]) } else { b(tri[k - 4]) }
         }
@@ -207,6 +214,7 @@ mod tests {
             ('▒', 0.5),
             ('\u{1FB6C}', 0.25),
             ('\u{1FB68}', 0.75),
+            ('\u{1FB9B}', 0.5),
             ('\u{1FB3D}', 1.0 / 6.0), // lower left, from 2/3 down the left side to the lower right
         ];
         for (ch, want) in cases {

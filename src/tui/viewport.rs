@@ -15,7 +15,7 @@ use crate::render::{Cull, DrawOptions, Rgba8};
 use crate::scene::Scene;
 use crate::scene::render::{SceneFrame, SceneView};
 use crate::terminal::fit;
-use crate::terminal::glyphs::{Sample, fit_cell, fit_cells8};
+use crate::terminal::glyphs::{FitSpace, Sample, fit_cell, fit_cells8};
 use crate::terminal::{CellGlyph, ColorMode, GlyphMode};
 
 /// What the viewer shows and how.
@@ -31,6 +31,8 @@ pub struct ViewSettings {
     pub angle: f32,
     pub tilt: f32,
     pub cull: bool,
+    /// Where the shape-fitted modes measure colour error.
+    pub fit_space: FitSpace,
 }
 
 impl Default for ViewSettings {
@@ -44,6 +46,7 @@ impl Default for ViewSettings {
             angle: 0.6,
             tilt: 0.25,
             cull: false,
+            fit_space: FitSpace::Srgb,
         }
     }
 }
@@ -201,23 +204,26 @@ impl Viewport {
         self.cells.clear();
         self.cells
             .resize(usize::from(cols) * usize::from(rows), CellGlyph::default());
-        let (mode, colors) = (self.settings.glyphs, self.settings.colors);
+        let (mode, colors, space) = (
+            self.settings.glyphs,
+            self.settings.colors,
+            self.settings.fit_space,
+        );
         if mode.dims() == (fit::SX as u32, fit::SY as u32) && colors != ColorMode::None {
-            // The shape fit runs 8 cells at a time, in lanes; a batch of empty cells
-            // (most of the background) is skipped.
-            let mut batch = [[Sample::default(); fit::N]; 8];
-            for cy in 0..rows {
-                for x0 in (0..cols).step_by(8) {
-                    let n = usize::from((cols - x0).min(8));
-                    let mut any = false;
-                    for (k, cell) in batch[..n].iter_mut().enumerate() {
-                        self.samples_into(x0 + k as u16, cy, cell);
-                        any |= cell.iter().any(|s| s.covered);
-                    }
-                    if any {
-                        let i = usize::from(cy) * usize::from(cols) + usize::from(x0);
-                        fit_cells8(mode, &batch[..n], colors, &mut self.cells[i..i + n]);
-                    }
+            // The shape fit runs 8 cells at a time, in lanes, straight from the frame's
+            // rows; a batch of empty cells (most of the background) is skipped.
+            let w = self.target.width as usize;
+            for cy in 0..usize::from(rows) {
+                let row0 = cy * fit::SY * w;
+                for x0 in (0..usize::from(cols)).step_by(8) {
+                    let n = (usize::from(cols) - x0).min(8);
+                    let start = row0 + x0 * fit::SX;
+                    let sample_rows: [&[[u8; 4]]; fit::SY] = std::array::from_fn(|j| {
+                        let at = start + j * w;
+                        &self.color.0[at..at + n * fit::SX]
+                    });
+                    let i = cy * usize::from(cols) + x0;
+                    fit_cells8(mode, colors, space, sample_rows, &mut self.cells[i..i + n]);
                 }
             }
         } else {
@@ -228,7 +234,7 @@ impl Viewport {
                 for cx in 0..cols {
                     let n = self.samples_into(cx, cy, &mut s);
                     self.cells[usize::from(cy) * usize::from(cols) + usize::from(cx)] =
-                        fit_cell(mode, &s[..n], colors);
+                        fit_cell(mode, &s[..n], colors, space);
                 }
             }
         }

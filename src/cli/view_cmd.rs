@@ -22,7 +22,7 @@ pub struct LookArgs {
     /// Colour depth; detected from NO_COLOR, COLORTERM and TERM when not given.
     #[arg(long, value_enum)]
     pub color: Option<ColorMode>,
-    /// Where the shape-fitted glyph modes (blocks, ascii) measure colour error.
+    /// Where the shape-fitted glyph modes (wedges, blocks, ascii) measure colour error.
     #[arg(long, value_enum, default_value_t = FitSpace::Srgb)]
     pub fit_space: FitSpace,
     /// Cell width / height (terminal cells are about twice as tall as wide).

@@ -229,7 +229,6 @@ fn measure(
     })
 }
 
-/// Every termrast mode and colour depth of one view, then chafa's.
 /// Every mode as the viewer draws it, and the shape-fitted ones with their error
 /// measured in linear light too (what that choice costs).
 fn variants() -> impl Iterator<Item = (GlyphMode, FitSpace)> {
@@ -243,6 +242,7 @@ fn variants() -> impl Iterator<Item = (GlyphMode, FitSpace)> {
         ])
 }
 
+/// Every termrast mode and colour depth of one view, then chafa's.
 fn measure_view(
     config: &Config,
     model: &Model,

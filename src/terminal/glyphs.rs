@@ -1,8 +1,9 @@
 //! Glyph modes and the choice of a cell's glyph and two colours from its samples.
 //!
-//! Samples are row-major within the cell. `blocks` and `ascii` take 4 × 8 samples and
-//! choose the glyph and two colours that minimise the squared error in linear light
-//! over a repertoire of shapes ([`super::fit`]). The other modes split their samples,
+//! Samples are row-major within the cell. `wedges`, `blocks` and `ascii` take 4 × 8
+//! samples and choose the glyph and two colours that minimise the squared error (in
+//! sRGB-encoded values by default, see [`FitSpace`]) over a repertoire of shapes
+//! ([`super::fit`]). The other modes split their samples,
 //! ordered by luminance, where the summed squared colour error of the two groups is
 //! smallest; block modes draw the brighter group in the foreground, braille puts its
 //! dots on the smaller group (dots ink only a third of the cell, so the colour that

@@ -1,5 +1,5 @@
 //! Whole viewer frames (`cargo bench --bench viewer`): transform, raster, glyph
-//! fitting, ratatui's diff and the write to a byte-counting sink, at 200×60 cells in
+//! fitting, ratatui's diff, the perceptual cell cache and the write to a byte-counting sink, at 200×60 cells in
 //! braille and blocks modes, the model turning between frames as it does in the viewer.
 
 use std::cell::Cell;
@@ -8,11 +8,11 @@ use std::rc::Rc;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use ratatui::Terminal;
-use ratatui::backend::CrosstermBackend;
 use termrast::cli::view_cmd::load_model;
 use termrast::terminal::{ColorMode, GlyphMode};
 use termrast::tui::Counting;
 use termrast::tui::app::App;
+use termrast::tui::link::LinkBackend;
 use termrast::tui::viewport::ViewSettings;
 
 fn bench(c: &mut Criterion) {
@@ -38,7 +38,7 @@ fn bench(c: &mut Criterion) {
                 bytes: Rc::clone(&bytes),
             };
             let mut term = Terminal::with_options(
-                CrosstermBackend::new(sink),
+                LinkBackend::with_size(sink, 200, 61),
                 ratatui::TerminalOptions {
                     viewport: ratatui::Viewport::Fixed(ratatui::layout::Rect::new(0, 0, 200, 61)),
                 },

@@ -165,6 +165,10 @@ pub fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // Ended by a signal: the shell's convention, and nothing to say.
+        Err(CliError::View(crate::tui::ViewError::Signal(sig))) => {
+            ExitCode::from(u8::try_from(128 + sig).unwrap_or(255))
+        }
         Err(e) => {
             let _ = writeln!(io::stderr(), "termrast: {e}");
             ExitCode::FAILURE

@@ -9,6 +9,7 @@ pub mod ansi;
 pub mod color;
 pub mod fit;
 pub mod glyphs;
+pub mod input;
 pub mod locale;
 pub mod paint;
 mod shaped;

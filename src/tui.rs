@@ -1,33 +1,45 @@
 //! The interactive viewer: a spinning mesh on the cell grid, with a per-cell raster
 //! inspector and a line panel.
 //!
-//! The terminal is restored (raw mode, alternate screen, mouse capture, cursor) on
-//! quit, on panic (a chained panic hook) and on SIGINT, SIGTERM and SIGHUP (a flag the
-//! loop checks). Each frame is written in one go inside a synchronized update, and
-//! ratatui writes only the cells that changed. A paused viewer waits for input without
-//! a timeout, so it uses no CPU.
+//! The viewer leaves with its terminal: end of input or an error reading or writing
+//! the terminal ends it, and so do SIGHUP, SIGTERM, SIGINT and SIGQUIT (exit status
+//! 128 + the signal; if the main thread is stuck writing to a stalled link, a
+//! watchdog leaves half a second later). The terminal is restored on quit, on panic
+//! (a chained panic hook) and on those signals; Ctrl-Z (or SIGTSTP) restores it and
+//! suspends, and resuming re-enters the alternate screen and redraws everything.
+//!
+//! Input is read raw on its own thread and parsed by [`crate::terminal::input`];
+//! signals arrive on another thread; both wake the loop through one channel, so a
+//! paused viewer sleeps until something happens. Each frame is written in one go
+//! inside a synchronized update, followed by a query the terminal answers once it has
+//! read the frame: frames are paced by those answers ([`pacing`]).
 
 pub mod app;
 pub mod inspector;
+pub mod link;
+pub mod pacing;
 pub mod viewport;
 
 use std::cell::Cell;
-use std::io::{self, IsTerminal, Stdout, Write};
+use std::io::{self, IsTerminal, Read, Stdout, Write};
 use std::rc::Rc;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use ratatui::Terminal;
-use ratatui::backend::CrosstermBackend;
-use ratatui::crossterm::event::{self, DisableMouseCapture, EnableMouseCapture};
+use ratatui::crossterm::event::{
+    DisableMouseCapture, EnableMouseCapture, Event, KeyCode, KeyEvent, KeyModifiers,
+};
 use ratatui::crossterm::terminal::{
     BeginSynchronizedUpdate, EndSynchronizedUpdate, EnterAlternateScreen, LeaveAlternateScreen,
     disable_raw_mode, enable_raw_mode,
 };
 use ratatui::crossterm::{cursor, execute, queue};
 
-use app::App;
+use app::{App, LinkStatus};
+use pacing::Pacer;
+
+use crate::terminal::input::{Input, Parser};
 
 /// Counts the bytes written to the terminal into a shared counter.
 #[derive(Debug)]
@@ -58,6 +70,11 @@ pub enum ViewError {
     NotATerminal,
     #[error("{0}")]
     Unsupported(String),
+    #[error("the terminal went away (end of input)")]
+    Gone,
+    /// Ended by a signal: the process exits with 128 + its number.
+    #[error("ended by signal {0}")]
+    Signal(i32),
     #[error("terminal: {0}")]
     Io(#[from] io::Error),
 }
@@ -77,91 +94,279 @@ impl Drop for Guard {
     }
 }
 
-/// Runs the viewer until the user quits or a signal arrives.
-pub fn run(mut app: App, fps: u32) -> Result<(), ViewError> {
+/// How the viewer runs.
+#[derive(Clone, Copy, Debug)]
+pub struct RunOptions {
+    /// Frame rate cap.
+    pub fps: u32,
+    /// Output rate cap, bytes per second.
+    pub max_rate: Option<u64>,
+    /// Pace frames by the terminal's answers.
+    pub paced: bool,
+}
+
+/// What wakes the loop.
+enum Wake {
+    Bytes(Vec<u8>),
+    /// End of input, or an error reading it: the terminal is gone.
+    Eof,
+    Signal(i32),
+}
+
+/// Signals that end the viewer.
+const ENDING: [i32; 4] = [
+    signal_hook::consts::SIGTERM,
+    signal_hook::consts::SIGINT,
+    signal_hook::consts::SIGHUP,
+    signal_hook::consts::SIGQUIT,
+];
+
+/// Starts the input and signal threads.
+fn spawn_wakers() -> io::Result<mpsc::Receiver<Wake>> {
+    let (tx, rx) = mpsc::channel();
+    let input = tx.clone();
+    std::thread::Builder::new()
+        .name("input".into())
+        .spawn(move || {
+            let mut buf = [0u8; 4096];
+            // The terminal's input: stdin, or the controlling terminal when stdin is
+            // redirected.
+            let mut source: Box<dyn Read> = if io::stdin().is_terminal() {
+                Box::new(io::stdin())
+            } else {
+                match std::fs::File::open("/dev/tty") {
+                    Ok(f) => Box::new(f),
+                    Err(_) => {
+                        let _ = input.send(Wake::Eof);
+                        return;
+                    }
+                }
+            };
+            loop {
+                match source.read(&mut buf) {
+                    Ok(0) | Err(_) => {
+                        let _ = input.send(Wake::Eof);
+                        return;
+                    }
+                    Ok(n) => {
+                        if input.send(Wake::Bytes(buf[..n].to_vec())).is_err() {
+                            return;
+                        }
+                    }
+                }
+            }
+        })?;
+    let mut signals = signal_hook::iterator::Signals::new(ENDING.iter().copied().chain([
+        signal_hook::consts::SIGTSTP,
+        signal_hook::consts::SIGCONT,
+        signal_hook::consts::SIGWINCH,
+    ]))?;
+    std::thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            for sig in signals.forever() {
+                let _ = tx.send(Wake::Signal(sig));
+                if ENDING.contains(&sig) {
+                    // The main thread leaves at once unless it is stuck writing to a
+                    // stalled terminal; then leave from here (no escape sequences: the
+                    // output is what is stuck).
+                    std::thread::sleep(Duration::from_millis(500));
+                    let _ = disable_raw_mode();
+                    std::process::exit(128 + sig);
+                }
+            }
+        })?;
+    Ok(rx)
+}
+
+fn enter(out: &mut impl Write) -> io::Result<()> {
+    enable_raw_mode()?;
+    execute!(out, EnterAlternateScreen, EnableMouseCapture, cursor::Hide)
+}
+
+/// Runs the viewer until the user quits, the terminal goes away or a signal ends it.
+pub fn run(mut app: App, options: RunOptions) -> Result<(), ViewError> {
     if !io::stdout().is_terminal() {
         return Err(ViewError::NotATerminal);
     }
-    let stop = Arc::new(AtomicBool::new(false));
-    for sig in [
-        signal_hook::consts::SIGTERM,
-        signal_hook::consts::SIGINT,
-        signal_hook::consts::SIGHUP,
-    ] {
-        signal_hook::flag::register(sig, Arc::clone(&stop))?;
-    }
+    let wakes = spawn_wakers()?;
     let previous = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
         restore();
         previous(info);
     }));
-    enable_raw_mode()?;
     let _guard = Guard;
-    execute!(
-        io::stdout(),
-        EnterAlternateScreen,
-        EnableMouseCapture,
-        cursor::Hide
-    )?;
+    enter(&mut io::stdout())?;
     let bytes = Rc::new(Cell::new(0));
     let writer = Counting {
         inner: io::stdout(),
         bytes: Rc::clone(&bytes),
     };
-    let mut terminal = Terminal::new(CrosstermBackend::new(writer))?;
+    let mut terminal = Terminal::new(link::LinkBackend::new(writer))?;
     terminal.clear()?;
-    main_loop(&mut app, &mut terminal, fps.max(1), &stop, &bytes)
+    let mut pacer = Pacer::new(options.paced, options.max_rate);
+    let mut parser = Parser::default();
+    let result = main_loop(
+        &mut app,
+        &mut terminal,
+        options.fps.max(1),
+        (&wakes, &mut parser),
+        &mut pacer,
+        &bytes,
+    );
+    settle(&wakes, &mut parser, &mut pacer);
+    result
+}
+
+/// Before the terminal leaves raw mode, waits a little for the answers to queries
+/// still on their way, so they reach the viewer and not the shell after it.
+fn settle(wakes: &mpsc::Receiver<Wake>, parser: &mut Parser, pacer: &mut Pacer) {
+    let until = Instant::now() + Duration::from_millis(300);
+    while pacer.in_flight() > 0 {
+        let Some(left) = until.checked_duration_since(Instant::now()) else {
+            return;
+        };
+        match wakes.recv_timeout(left) {
+            Ok(Wake::Bytes(b)) => {
+                let now = Instant::now();
+                parser.feed(&b, now);
+                while let Some(input) = parser.next(now) {
+                    if input == Input::DeviceAttributes {
+                        pacer.answered(now);
+                    }
+                }
+            }
+            Ok(Wake::Signal(_)) => {}
+            Ok(Wake::Eof) | Err(_) => return,
+        }
+    }
+}
+
+type Term = Terminal<link::LinkBackend<Counting<Stdout>>>;
+
+/// Draws one frame and the pacing query after it.
+fn draw(
+    app: &mut App,
+    terminal: &mut Term,
+    pacer: &mut Pacer,
+    bytes: &Cell<u64>,
+) -> io::Result<()> {
+    let start_bytes = bytes.get();
+    queue!(terminal.backend_mut(), BeginSynchronizedUpdate)?;
+    let t0 = Instant::now();
+    let mut render_time = Duration::ZERO;
+    terminal.draw(|f| {
+        let r = Instant::now();
+        app.draw(f);
+        render_time = r.elapsed();
+    })?;
+    queue!(terminal.backend_mut(), EndSynchronizedUpdate)?;
+    if pacer.wants_query() {
+        terminal.backend_mut().write_all(pacing::QUERY)?;
+    }
+    terminal.backend_mut().flush()?;
+    app.output_time = t0.elapsed().saturating_sub(render_time);
+    app.bytes = bytes.get() - start_bytes;
+    pacer.sent(Instant::now(), app.bytes);
+    Ok(())
+}
+
+/// Ctrl-Z: restores the terminal, stops, and on resuming takes it again.
+fn suspend(terminal: &mut Term, pacer: &mut Pacer) -> io::Result<()> {
+    restore();
+    signal_hook::low_level::raise(signal_hook::consts::SIGSTOP)?;
+    resume(terminal, pacer)
+}
+
+fn resume(terminal: &mut Term, pacer: &mut Pacer) -> io::Result<()> {
+    enter(terminal.backend_mut())?;
+    pacer.reset();
+    terminal.clear()
 }
 
 fn main_loop(
     app: &mut App,
-    terminal: &mut Terminal<CrosstermBackend<Counting<Stdout>>>,
+    terminal: &mut Term,
     fps: u32,
-    stop: &AtomicBool,
+    (wakes, parser): (&mpsc::Receiver<Wake>, &mut Parser),
+    pacer: &mut Pacer,
     bytes: &Cell<u64>,
 ) -> Result<(), ViewError> {
     let period = Duration::from_secs_f64(1.0 / f64::from(fps));
     let mut last = Instant::now();
+    let mut next_frame = last;
+    let mut last_frame = last;
     let mut dirty = true;
-    while !app.quit && !stop.load(Ordering::Relaxed) {
+    let ctrl_z = Event::Key(KeyEvent::new(KeyCode::Char('z'), KeyModifiers::CONTROL));
+    while !app.quit {
         let now = Instant::now();
-        app.tick(now - last);
-        if dirty || !app.paused {
-            let frame_time = now - last;
+        let wanted = dirty || !app.paused;
+        if wanted && now >= next_frame && pacer.may_send(now) {
+            app.tick(now - last);
             last = now;
-            let start_bytes = bytes.get();
-            queue!(terminal.backend_mut(), BeginSynchronizedUpdate)?;
-            let t0 = Instant::now();
-            let mut render_time = Duration::ZERO;
-            terminal.draw(|f| {
-                let r = Instant::now();
-                app.draw(f);
-                render_time = r.elapsed();
-            })?;
-            queue!(terminal.backend_mut(), EndSynchronizedUpdate)?;
-            terminal.backend_mut().flush()?;
-            app.output_time = t0.elapsed().saturating_sub(render_time);
-            app.bytes = bytes.get() - start_bytes;
+            let frame_time = now - last_frame;
+            last_frame = now;
+            app.link = LinkStatus {
+                bytes_per_second: pacer.bytes_per_second(now),
+                rtt: pacer.rtt,
+                delivered_fps: pacer.delivered_fps(now),
+                unpaced: pacer.unpaced && pacer.wants_query(),
+            };
+            draw(app, terminal, pacer, bytes)?;
             if !app.paused && frame_time > Duration::ZERO {
                 app.fps = 0.8 * app.fps + 0.2 / frame_time.as_secs_f32();
             }
+            next_frame = now + period;
             dirty = false;
-        } else {
-            last = now;
+            continue;
         }
-        // Spinning: wait until the next frame is due. Paused: wait for input, waking
-        // twice a second only to notice signals.
-        let wait = if app.paused {
-            Duration::from_millis(500)
-        } else {
-            period.saturating_sub(last.elapsed())
+        if !app.paused {
+            app.tick(now - last);
+        }
+        last = now;
+        // Sleep until the next frame is due (or what holds it, the pacer, may let it
+        // go), a pending escape resolves, or input or a signal arrives.
+        let wake_at = [
+            wanted.then(|| next_frame.max(pacer.wake_at().unwrap_or(next_frame))),
+            parser.deadline(),
+        ]
+        .into_iter()
+        .flatten()
+        .min();
+        let timeout = wake_at.map_or(Duration::from_secs(3600), |t| {
+            t.saturating_duration_since(now)
+        });
+        let wake = match wakes.recv_timeout(timeout) {
+            Ok(w) => Some(w),
+            Err(mpsc::RecvTimeoutError::Timeout) => None,
+            Err(mpsc::RecvTimeoutError::Disconnected) => Some(Wake::Eof),
         };
-        if event::poll(wait)? {
-            loop {
-                dirty |= app.handle(&event::read()?);
-                if !event::poll(Duration::ZERO)? {
-                    break;
+        match wake {
+            Some(Wake::Bytes(b)) => parser.feed(&b, Instant::now()),
+            Some(Wake::Eof) => return Err(ViewError::Gone),
+            Some(Wake::Signal(sig)) if ENDING.contains(&sig) => {
+                return Err(ViewError::Signal(sig));
+            }
+            Some(Wake::Signal(signal_hook::consts::SIGTSTP)) => {
+                suspend(terminal, pacer)?;
+                dirty = true;
+            }
+            Some(Wake::Signal(signal_hook::consts::SIGCONT)) => {
+                resume(terminal, pacer)?;
+                dirty = true;
+            }
+            Some(Wake::Signal(_)) => dirty = true,
+            None => {}
+        }
+        let now = Instant::now();
+        while let Some(input) = parser.next(now) {
+            match input {
+                Input::DeviceAttributes => pacer.answered(now),
+                Input::Event(e) if e == ctrl_z => {
+                    suspend(terminal, pacer)?;
+                    dirty = true;
                 }
+                Input::Event(e) => dirty |= app.handle(&e),
             }
         }
     }

@@ -12,6 +12,11 @@ struct Tmux {
 
 impl Tmux {
     fn new(tag: &str) -> Option<Self> {
+        Self::with_shell(tag, "sh")
+    }
+
+    /// A session running `shell` (a job-control shell for Ctrl-Z).
+    fn with_shell(tag: &str, shell: &str) -> Option<Self> {
         Command::new("tmux")
             .arg("-V")
             .output()
@@ -31,7 +36,7 @@ impl Tmux {
                 "130",
                 "-y",
                 "40",
-                "sh",
+                shell,
             ])
             .is_some();
         ok.then_some(t)
@@ -102,8 +107,18 @@ impl Tmux {
     }
 
     fn assert_restored(&self) {
+        self.assert_restored_with(0);
+    }
+
+    /// The viewer exited with `code` and left the terminal as it found it.
+    fn assert_restored_with(&self, code: i32) {
         let s = self.wait_for("EXIT=");
-        assert!(s.contains("EXIT=0"), "viewer did not exit cleanly:\n{s}");
+        assert!(
+            s.contains(&format!("EXIT={code}")),
+            "viewer did not exit with {code}:\n{s}"
+        );
+        // No answer to the viewer's pacing queries leaked to the shell.
+        assert!(!s.contains("[?"), "terminal replies leaked:\n{s}");
         assert_eq!(self.flags(), "0 0 1", "alternate screen, mouse, cursor");
         self.keys(&["stty -a | tr ' ' '\\n' | grep -x -- '-*icanon'", "Enter"]);
         sleep(Duration::from_millis(300));
@@ -148,21 +163,114 @@ fn inspect_pause_quit_and_restore() {
     t.assert_restored();
 }
 
+impl Tmux {
+    /// The viewer's process: the child of the pane's shell.
+    fn viewer_pid(&self) -> String {
+        let shell = self
+            .run(&["display", "-p", "-t", "t", "#{pane_pid}"])
+            .unwrap_or_default();
+        let out = Command::new("pgrep")
+            .args(["-P", shell.trim()])
+            .output()
+            .expect("pgrep");
+        String::from_utf8_lossy(&out.stdout).trim().to_string()
+    }
+
+    fn signal(&self, sig: &str) {
+        let pid = self.viewer_pid();
+        let ok = Command::new("kill").args([sig, &pid]).status();
+        assert!(ok.is_ok_and(|s| s.success()), "kill {sig} {pid}");
+    }
+}
+
+/// Whether a process is gone (or only a zombie waiting to be reaped).
+fn gone(pid: &str) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat")).map_or(true, |s| {
+        s.rsplit(')')
+            .next()
+            .is_some_and(|r| r.trim_start().starts_with('Z'))
+    })
+}
+
 #[test]
-fn sigterm_restores_the_terminal() {
-    let Some(t) = Tmux::new("term") else {
+fn ending_signals_restore_the_terminal_and_set_the_exit_status() {
+    for (sig, code) in [("-TERM", 143), ("-QUIT", 131), ("-HUP", 129)] {
+        let Some(t) = Tmux::new("term") else {
+            eprintln!("tmux not installed: skipping the terminal end-to-end test");
+            return;
+        };
+        t.start_viewer();
+        t.signal(sig);
+        t.assert_restored_with(code);
+    }
+}
+
+#[test]
+fn ctrl_q_and_esc_do_not_quit() {
+    let Some(t) = Tmux::new("ctrlq") else {
         eprintln!("tmux not installed: skipping the terminal end-to-end test");
         return;
     };
     t.start_viewer();
-    // Signal only the viewer of this test's pane (other tests run their own).
-    let shell = t
-        .run(&["display", "-p", "-t", "t", "#{pane_pid}"])
-        .unwrap_or_default();
-    let out = Command::new("pkill")
-        .args(["-TERM", "-P", shell.trim()])
-        .status();
-    assert!(out.is_ok_and(|s| s.success()), "pkill found the viewer");
+    t.keys(&["C-q", "Escape", "Q"]);
+    sleep(Duration::from_millis(800));
+    assert_eq!(t.flags(), "1 1 0", "the viewer quit:\n{}", t.screen());
+    t.keys(&["q"]);
+    t.assert_restored();
+}
+
+#[test]
+fn the_viewer_leaves_with_its_terminal() {
+    for keys in [&[][..], &[" "][..]] {
+        let Some(t) = Tmux::new("hangup") else {
+            eprintln!("tmux not installed: skipping the terminal end-to-end test");
+            return;
+        };
+        t.start_viewer();
+        t.keys(keys);
+        sleep(Duration::from_millis(300));
+        let pid = t.viewer_pid();
+        assert!(!pid.is_empty() && !gone(&pid));
+        t.run(&["kill-server"]);
+        let start = Instant::now();
+        while !gone(&pid) && start.elapsed() < Duration::from_secs(3) {
+            sleep(Duration::from_millis(50));
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(1),
+            "viewer {pid} (keys {keys:?}) still running {:?} after its terminal closed",
+            start.elapsed()
+        );
+    }
+}
+
+#[test]
+fn ctrl_z_suspends_and_fg_redraws() {
+    let Some(t) = Tmux::with_shell("suspend", "bash --norc --noprofile -i") else {
+        eprintln!("tmux not installed: skipping the terminal end-to-end test");
+        return;
+    };
+    // No `; echo EXIT` here: bash would run it as soon as the job stops.
+    let cmd = format!("TERM=xterm-256color {}", env!("CARGO_BIN_EXE_termrast"));
+    t.keys(&["clear", "Enter", &cmd, "Enter"]);
+    assert!(
+        t.wait_for("fps |").contains("fps |"),
+        "viewer did not start"
+    );
+    t.keys(&["C-z"]);
+    let s = t.wait_for("Stopped");
+    assert!(s.contains("Stopped"), "not suspended:\n{s}");
+    assert_eq!(
+        t.flags(),
+        "0 0 1",
+        "suspended without restoring the terminal"
+    );
+    t.keys(&["clear", "Enter", "fg", "Enter"]);
+    let s = t.wait_for("fps |");
+    assert!(s.contains("fps |"), "not redrawn after fg:\n{s}");
+    assert_eq!(t.flags(), "1 1 0");
+    t.keys(&["q"]);
+    t.keys(&["echo EXIT=$?", "Enter"]);
     t.assert_restored();
 }
 

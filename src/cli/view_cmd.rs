@@ -104,6 +104,13 @@ pub struct ViewArgs {
     /// Frame rate cap.
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=240))]
     pub fps: u32,
+    /// Output rate cap in bytes per second (frames wait for it), on top of pacing by
+    /// the terminal's answers.
+    #[arg(long, value_name = "BYTES/S", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_rate: Option<u64>,
+    /// Send frames without waiting for the terminal's answers.
+    #[arg(long)]
+    pub no_pacing: bool,
 }
 
 /// Loads a model with normals and edges.
@@ -127,7 +134,14 @@ pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
         App::new(load_model(&args.model)?, settings)
     };
     app.notice = args.look.notice_in(env);
-    crate::tui::run(app, args.fps)?;
+    crate::tui::run(
+        app,
+        crate::tui::RunOptions {
+            fps: args.fps,
+            max_rate: args.max_rate,
+            paced: !args.no_pacing,
+        },
+    )?;
     Ok(())
 }
 

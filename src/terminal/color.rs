@@ -91,6 +91,29 @@ pub fn to_linear(v: u8) -> f32 {
     linear_table()[usize::from(v)]
 }
 
+/// An 8-bit sRGB colour in OKLab (Björn Ottosson, 2020): lightness and two opponent
+/// axes in which Euclidean distance follows perceived difference (a just-noticeable
+/// difference is about 0.02).
+#[must_use]
+pub fn oklab(c: Rgb) -> [f32; 3] {
+    let [r, g, b] = c.map(to_linear);
+    let l = (0.412_221_46 * r + 0.536_332_55 * g + 0.051_445_995 * b).cbrt();
+    let m = (0.211_903_5 * r + 0.680_699_5 * g + 0.107_396_96 * b).cbrt();
+    let s = (0.088_302_46 * r + 0.281_718_85 * g + 0.629_978_7 * b).cbrt();
+    [
+        0.210_454_26 * l + 0.793_617_8 * m - 0.004_072_047 * s,
+        1.977_998_5 * l - 2.428_592_2 * m + 0.450_593_7 * s,
+        0.025_904_037 * l + 0.782_771_77 * m - 0.808_675_77 * s,
+    ]
+}
+
+/// Perceived difference of two colours: Euclidean distance in [`oklab`].
+#[must_use]
+pub fn delta_e(a: Rgb, b: Rgb) -> f32 {
+    let (p, q) = (oklab(a), oklab(b));
+    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+}
+
 fn linear_table() -> &'static [f32; 256] {
     static T: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
     T.get_or_init(|| {

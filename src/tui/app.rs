@@ -52,6 +52,8 @@ pub struct App {
     pub status: String,
     /// Said once at the start of the status line, until the first key.
     pub notice: Option<String>,
+    /// What the link to the terminal carries, for the status line.
+    pub link: LinkStatus,
     drag: Option<(u16, u16)>,
     /// Area of the viewport on screen, from the last draw.
     view_area: Rect,
@@ -59,6 +61,19 @@ pub struct App {
     pub scene: Option<SceneState>,
     /// Show the scene's plan.
     pub show_plan: bool,
+}
+
+/// The link to the terminal as the status line shows it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LinkStatus {
+    /// Bytes sent per second, recently.
+    pub bytes_per_second: f64,
+    /// Round trip of the last answered frame, if frames are paced.
+    pub rtt: Option<Duration>,
+    /// Frames the terminal confirmed per second.
+    pub delivered_fps: f32,
+    /// The terminal does not answer queries: frames are not paced.
+    pub unpaced: bool,
 }
 
 /// A scene in the viewer: what it is, its pipelines and buffers, and its time.
@@ -90,6 +105,7 @@ impl App {
             bytes: 0,
             status: String::with_capacity(256),
             notice: None,
+            link: LinkStatus::default(),
             drag: None,
             view_area: Rect::default(),
             scene: None,
@@ -204,9 +220,28 @@ impl App {
     fn key(&mut self, k: KeyEvent) -> bool {
         self.notice = None;
         let ctrl = k.modifiers.contains(KeyModifiers::CONTROL);
+        if ctrl && k.code == KeyCode::Char('c') {
+            self.quit = true;
+            return true;
+        }
+        // Ctrl or Alt with a key is not the key (Ctrl-Q is not q).
+        if k.modifiers
+            .intersects(KeyModifiers::CONTROL | KeyModifiers::ALT)
+        {
+            return false;
+        }
         match k.code {
-            KeyCode::Char('c') if ctrl => self.quit = true,
-            KeyCode::Char('q') | KeyCode::Esc => {
+            // Esc closes what is open and never quits: a sequence split over a slow link
+            // may begin with a stray one.
+            KeyCode::Esc => {
+                if self.help || self.show_plan {
+                    self.help = false;
+                    self.show_plan = false;
+                } else {
+                    self.inspect = false;
+                }
+            }
+            KeyCode::Char('q') => {
                 if self.help || self.show_plan {
                     self.help = false;
                     self.show_plan = false;
@@ -398,7 +433,7 @@ impl App {
         }
         let _ = write!(
             self.status,
-            "{}{}{} {} {} | {:.0} fps | transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms | tris {} drawn {} culled {} clipped | {} B | ? help",
+            "{}{}{} {} {} | {:.0} fps | transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms | tris {} drawn {} culled {} clipped | {} B",
             if self.paused { "paused | " } else { "" },
             if self.inspect { "inspect | " } else { "" },
             self.settings.glyphs.name(),
@@ -414,6 +449,23 @@ impl App {
             s.clipped,
             self.bytes,
         );
+        let l = self.link;
+        let _ = write!(self.status, " | {:.0} kB/s", l.bytes_per_second / 1e3);
+        match l.rtt {
+            _ if l.unpaced => {
+                let _ = write!(self.status, " unpaced (no answer)");
+            }
+            Some(rtt) => {
+                let _ = write!(
+                    self.status,
+                    " rtt {:.0} ms {:.0} fps delivered",
+                    ms(rtt),
+                    l.delivered_fps
+                );
+            }
+            None => {}
+        }
+        self.status.push_str(" | ? help");
         if let Some(sc) = &self.scene {
             let _ = write!(self.status, " | plan: {} (p)", sc.scene.plan.summary());
         }
@@ -432,7 +484,7 @@ impl App {
                     [ ]       step along the line in the line panel\n\
                     drag      rotate\n\
                     p         the scene's plan (scenes only)\n\
-                    ?         this help        q / Esc / Ctrl-C  quit";
+                    ?         this help        Esc  close      q / Ctrl-C  quit";
         let w = 72.min(area.width);
         let h = 15.min(area.height);
         let r = Rect::new(

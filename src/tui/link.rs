@@ -1,0 +1,392 @@
+//! The ratatui backend that sends what the eye can see and nothing else.
+//!
+//! It keeps the terminal's cells as they were last sent (`shown`) beside the frame
+//! ratatui asks for (`wanted`). A cell changed in this frame is sent when its text or
+//! attributes change, or when one of its colours is more than [`DELTA_E`] from what
+//! the terminal shows (a distance in OKLab, about two just-noticeable differences):
+//! the screen never strays further than that from the true frame. A cell that did not
+//! change in this frame but is shown only approximately is sent exactly, so a still
+//! model shows the exact frame one frame after it stops. Colours are written only
+//! when they change (foreground and background apart), and the cursor moves by the
+//! shortest sequence. Everything is written to the terminal in one write per frame.
+
+use std::io::{self, Write};
+
+use ratatui::backend::{Backend, ClearType, WindowSize};
+use ratatui::buffer::Cell;
+use ratatui::layout::{Position, Size};
+use ratatui::style::{Color, Modifier};
+
+use crate::terminal::color::delta_e;
+
+/// How far (OKLab distance) a changed cell's colour may stray from the true frame.
+pub const DELTA_E: f32 = 0.04;
+
+/// The pen: attributes the terminal will draw the next character with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Pen {
+    fg: Color,
+    bg: Color,
+    modifier: Modifier,
+}
+
+const DEFAULT_PEN: Pen = Pen {
+    fg: Color::Reset,
+    bg: Color::Reset,
+    modifier: Modifier::empty(),
+};
+
+/// A backend writing to `out` through a cell cache.
+#[derive(Debug)]
+pub struct LinkBackend<W: Write> {
+    out: W,
+    /// Bytes of the frame being built.
+    buf: Vec<u8>,
+    cols: u16,
+    rows: u16,
+    wanted: Vec<Cell>,
+    shown: Vec<Cell>,
+    /// Cells ratatui changed in this frame.
+    changed: Vec<bool>,
+    /// Where the terminal's cursor is, if known.
+    cursor: Option<(u16, u16)>,
+    /// Whether the cursor is hidden, if known (ratatui hides it every frame).
+    hidden: Option<bool>,
+    pen: Option<Pen>,
+    /// The size reported to ratatui; `None` asks the terminal.
+    fixed: Option<Size>,
+    /// Colour threshold in use ([`DELTA_E`], or 0 to send every change).
+    pub threshold: f32,
+}
+
+impl<W: Write> LinkBackend<W> {
+    /// A backend for the terminal on `out`, its size from the terminal.
+    pub fn new(out: W) -> Self {
+        Self::sized(out, None)
+    }
+
+    /// A backend of a fixed size (for tests and benchmarks).
+    pub fn with_size(out: W, cols: u16, rows: u16) -> Self {
+        Self::sized(out, Some(Size::new(cols, rows)))
+    }
+
+    fn sized(out: W, fixed: Option<Size>) -> Self {
+        let mut b = Self {
+            out,
+            buf: Vec::with_capacity(1 << 16),
+            cols: 0,
+            rows: 0,
+            wanted: Vec::new(),
+            shown: Vec::new(),
+            changed: Vec::new(),
+            cursor: None,
+            hidden: None,
+            pen: None,
+            fixed,
+            threshold: DELTA_E,
+        };
+        let s = b.size().unwrap_or(Size::new(80, 24));
+        b.reset(s);
+        b
+    }
+
+    /// The writer.
+    pub fn writer(&mut self) -> &mut W {
+        &mut self.out
+    }
+
+    /// Forgets what the terminal shows (after it was cleared, or is not trusted).
+    fn reset(&mut self, s: Size) {
+        self.cols = s.width;
+        self.rows = s.height;
+        let n = usize::from(s.width) * usize::from(s.height);
+        self.wanted.clear();
+        self.wanted.resize(n, Cell::EMPTY);
+        self.shown.clear();
+        self.shown.resize(n, Cell::EMPTY);
+        self.changed.clear();
+        self.changed.resize(n, false);
+        self.cursor = None;
+        self.pen = None;
+        self.hidden = None;
+    }
+
+    /// Whether the shown cell `s` stands for the wanted `w` closely enough.
+    fn close_enough(&self, s: &Cell, w: &Cell) -> bool {
+        if s.symbol() != w.symbol() || s.modifier != w.modifier {
+            return false;
+        }
+        let near = |a: Color, b: Color| match (a, b) {
+            _ if a == b => true,
+            (Color::Rgb(r0, g0, b0), Color::Rgb(r1, g1, b1)) => {
+                delta_e([r0, g0, b0], [r1, g1, b1]) <= self.threshold
+            }
+            _ => false,
+        };
+        near(s.fg, w.fg) && near(s.bg, w.bg)
+    }
+
+    /// Appends what takes the terminal from `shown` to `wanted`.
+    fn encode(&mut self) {
+        let cols = usize::from(self.cols);
+        for i in 0..self.wanted.len() {
+            let (w, s) = (&self.wanted[i], &self.shown[i]);
+            if w == s || (self.changed[i] && self.close_enough(s, w)) {
+                self.changed[i] = false;
+                continue;
+            }
+            self.changed[i] = false;
+            let (x, y) = ((i % cols) as u16, (i / cols) as u16);
+            if w.symbol().is_empty() {
+                // The trailing half of a wide character: drawn by the cell before it.
+                self.shown[i] = w.clone();
+                continue;
+            }
+            self.move_to(x, y);
+            let w = self.wanted[i].clone();
+            self.set_pen(Pen {
+                fg: w.fg,
+                bg: w.bg,
+                modifier: w.modifier,
+            });
+            self.buf.extend_from_slice(w.symbol().as_bytes());
+            self.cursor = narrow(w.symbol()).then_some((x + 1, y));
+            self.shown[i] = w;
+        }
+    }
+
+    /// The shortest move of the cursor to `(x, y)`.
+    fn move_to(&mut self, x: u16, y: u16) {
+        match self.cursor {
+            Some((cx, cy)) if (cx, cy) == (x, y) => {}
+            Some((cx, cy)) if cy == y && x > cx => {
+                let n = x - cx;
+                if n == 1 {
+                    self.buf.extend_from_slice(b"\x1b[C");
+                } else {
+                    let _ = write!(self.buf, "\x1b[{n}C");
+                }
+            }
+            Some((_, cy)) if x == 0 && y == cy + 1 => self.buf.extend_from_slice(b"\r\n"),
+            _ if x == 0 => {
+                let _ = write!(self.buf, "\x1b[{}H", y + 1);
+            }
+            _ => {
+                let _ = write!(self.buf, "\x1b[{};{}H", y + 1, x + 1);
+            }
+        }
+        self.cursor = Some((x, y));
+    }
+
+    /// Sets only what differs from the current pen, in one SGR sequence.
+    fn set_pen(&mut self, p: Pen) {
+        let mut cur = self.pen.unwrap_or(Pen {
+            // Unknown: force every attribute.
+            fg: Color::Indexed(255),
+            bg: Color::Indexed(255),
+            modifier: Modifier::all(),
+        });
+        if cur == p {
+            return;
+        }
+        let mut sgr = Sgr::new(&mut self.buf);
+        if !(cur.modifier - p.modifier).is_empty() {
+            // An attribute is switched off: reset and set what remains.
+            sgr.param(format_args!("0"));
+            cur = DEFAULT_PEN;
+        }
+        for (m, code) in [
+            (Modifier::BOLD, 1),
+            (Modifier::DIM, 2),
+            (Modifier::ITALIC, 3),
+            (Modifier::UNDERLINED, 4),
+            (Modifier::SLOW_BLINK, 5),
+            (Modifier::RAPID_BLINK, 6),
+            (Modifier::REVERSED, 7),
+            (Modifier::HIDDEN, 8),
+            (Modifier::CROSSED_OUT, 9),
+        ] {
+            if p.modifier.contains(m) && !cur.modifier.contains(m) {
+                sgr.param(format_args!("{code}"));
+            }
+        }
+        if cur.fg != p.fg {
+            sgr.color(p.fg, 30);
+        }
+        if cur.bg != p.bg {
+            sgr.color(p.bg, 40);
+        }
+        sgr.end();
+        self.pen = Some(p);
+    }
+}
+
+/// One SGR sequence being written: parameters separated by `;`.
+struct Sgr<'a> {
+    buf: &'a mut Vec<u8>,
+    first: bool,
+}
+
+impl<'a> Sgr<'a> {
+    fn new(buf: &'a mut Vec<u8>) -> Self {
+        buf.extend_from_slice(b"\x1b[");
+        Self { buf, first: true }
+    }
+
+    fn param(&mut self, p: std::fmt::Arguments) {
+        if !self.first {
+            self.buf.push(b';');
+        }
+        self.first = false;
+        let _ = self.buf.write_fmt(p);
+    }
+
+    /// A colour; `base` 30 for the foreground, 40 for the background.
+    fn color(&mut self, c: Color, base: u8) {
+        let named = |k: u8| base + k;
+        match c {
+            Color::Reset => self.param(format_args!("{}", named(9))),
+            Color::Black => self.param(format_args!("{}", named(0))),
+            Color::Red => self.param(format_args!("{}", named(1))),
+            Color::Green => self.param(format_args!("{}", named(2))),
+            Color::Yellow => self.param(format_args!("{}", named(3))),
+            Color::Blue => self.param(format_args!("{}", named(4))),
+            Color::Magenta => self.param(format_args!("{}", named(5))),
+            Color::Cyan => self.param(format_args!("{}", named(6))),
+            Color::Gray => self.param(format_args!("{}", named(7))),
+            Color::DarkGray => self.param(format_args!("{}", named(60))),
+            Color::LightRed => self.param(format_args!("{}", named(61))),
+            Color::LightGreen => self.param(format_args!("{}", named(62))),
+            Color::LightYellow => self.param(format_args!("{}", named(63))),
+            Color::LightBlue => self.param(format_args!("{}", named(64))),
+            Color::LightMagenta => self.param(format_args!("{}", named(65))),
+            Color::LightCyan => self.param(format_args!("{}", named(66))),
+            Color::White => self.param(format_args!("{}", named(67))),
+            Color::Indexed(i) => self.param(format_args!("{};5;{i}", named(8))),
+            Color::Rgb(r, g, b) => self.param(format_args!("{};2;{r};{g};{b}", named(8))),
+        }
+    }
+
+    fn end(self) {
+        self.buf.push(b'm');
+    }
+}
+
+/// Whether a symbol is one cell wide for sure; after any other the cursor's place is
+/// taken as unknown, so the next cell is placed absolutely.
+fn narrow(s: &str) -> bool {
+    let mut it = s.chars();
+    match (it.next(), it.next()) {
+        (Some(c), None) => matches!(c,
+            ' '..='~' | '\u{A0}'..='\u{2FF}' | '\u{2010}'..='\u{2027}' | '\u{2190}'..='\u{21FF}'
+            | '\u{2500}'..='\u{25FF}' | '\u{2800}'..='\u{28FF}' | '\u{1FB00}'..='\u{1FBAF}'),
+        _ => false,
+    }
+}
+
+impl<W: Write> Write for LinkBackend<W> {
+    fn write(&mut self, data: &[u8]) -> io::Result<usize> {
+        self.buf.extend_from_slice(data);
+        Ok(data.len())
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        Backend::flush(self)
+    }
+}
+
+impl<W: Write> Backend for LinkBackend<W> {
+    type Error = io::Error;
+
+    fn draw<'a, I>(&mut self, content: I) -> io::Result<()>
+    where
+        I: Iterator<Item = (u16, u16, &'a Cell)>,
+    {
+        for (x, y, c) in content {
+            if x < self.cols && y < self.rows {
+                let i = usize::from(y) * usize::from(self.cols) + usize::from(x);
+                self.wanted[i] = c.clone();
+                self.changed[i] = true;
+            }
+        }
+        self.encode();
+        Ok(())
+    }
+
+    fn hide_cursor(&mut self) -> io::Result<()> {
+        if self.hidden != Some(true) {
+            self.buf.extend_from_slice(b"\x1b[?25l");
+            self.hidden = Some(true);
+        }
+        Ok(())
+    }
+
+    fn show_cursor(&mut self) -> io::Result<()> {
+        if self.hidden != Some(false) {
+            self.buf.extend_from_slice(b"\x1b[?25h");
+            self.hidden = Some(false);
+        }
+        Ok(())
+    }
+
+    fn get_cursor_position(&mut self) -> io::Result<Position> {
+        // Never asked of the terminal: its answer would arrive on the input thread.
+        let (x, y) = self.cursor.unwrap_or((0, 0));
+        Ok(Position { x, y })
+    }
+
+    fn set_cursor_position<P: Into<Position>>(&mut self, position: P) -> io::Result<()> {
+        let p = position.into();
+        self.move_to(p.x, p.y);
+        Ok(())
+    }
+
+    fn clear(&mut self) -> io::Result<()> {
+        self.clear_region(ClearType::All)
+    }
+
+    fn clear_region(&mut self, clear_type: ClearType) -> io::Result<()> {
+        // Only the whole screen is cleared in a full-screen viewer; anything else is
+        // redrawn cell by cell, since the cache must know what the screen shows.
+        let s = self.size()?;
+        if clear_type == ClearType::All {
+            self.buf.extend_from_slice(b"\x1b[0m\x1b[2J");
+        }
+        self.reset(s);
+        if clear_type != ClearType::All {
+            // The cache no longer knows the screen: mark every cell as unknown.
+            for c in &mut self.shown {
+                c.set_symbol("\u{0}");
+            }
+        }
+        Ok(())
+    }
+
+    fn size(&self) -> io::Result<Size> {
+        match self.fixed {
+            Some(s) => Ok(s),
+            None => {
+                let (w, h) = ratatui::crossterm::terminal::size()?;
+                Ok(Size::new(w, h))
+            }
+        }
+    }
+
+    fn window_size(&mut self) -> io::Result<WindowSize> {
+        let s = self.size()?;
+        Ok(WindowSize {
+            columns_rows: s,
+            pixels: Size::new(0, 0),
+        })
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        if !self.buf.is_empty() {
+            self.out.write_all(&self.buf)?;
+            self.buf.clear();
+        }
+        self.out.flush()
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -6,6 +6,7 @@ pub mod accuracy_cmd;
 pub mod effects_cmd;
 pub mod fidelity_cmd;
 pub mod line_cmd;
+pub mod link_cmd;
 pub mod raster_cmd;
 pub mod render_cmd;
 pub mod view_cmd;
@@ -64,6 +65,9 @@ pub enum BenchCommand {
     /// frame of every glyph mode and colour depth (and chafa's, if installed),
     /// through a terminal emulator.
     Fidelity(fidelity_cmd::FidelityArgs),
+    /// The viewer behind a slow link (a pseudo-terminal drained at a set rate through
+    /// a 2 MB buffer into a terminal emulator): key-to-screen time and frame rate.
+    Link(link_cmd::LinkArgs),
 }
 
 /// Errors of the commands, each naming what it is about.
@@ -83,6 +87,8 @@ pub enum CliError {
     Scene(#[from] crate::scene::SceneError),
     #[error(transparent)]
     Fidelity(#[from] crate::fidelity::FidelityError),
+    #[error(transparent)]
+    Link(#[from] crate::slowlink::LinkError),
     #[error(transparent)]
     Io(#[from] io::Error),
 }
@@ -159,6 +165,9 @@ pub fn main() -> ExitCode {
         }
         Some(Command::Bench(BenchCommand::Fidelity(args))) => {
             fidelity_cmd::run(&args, &mut io::stdout().lock())
+        }
+        Some(Command::Bench(BenchCommand::Link(args))) => {
+            link_cmd::run(&args, &mut io::stdout().lock())
         }
         Some(Command::View(args)) => view_cmd::view(&args),
         None => view_cmd::view(&cli.view),

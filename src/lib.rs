@@ -14,6 +14,7 @@ pub mod raster;
 pub mod render;
 pub mod scene;
 pub mod simd;
+pub mod slowlink;
 pub mod terminal;
 pub mod tui;
 pub mod workload;

@@ -15,40 +15,21 @@ use ratatui::style::Color;
 use super::ColorMode;
 use super::glyphs::CellGlyph;
 
-/// SGR parameters that set the foreground (`fg`) or background colour `c`.
-fn sgr(out: &mut Vec<u8>, c: Color, fg: bool) {
+/// Writes the SGR parameters that set the foreground (`fg`) or background colour `c`
+/// in their shortest form (no `ESC [` or `m`): shared by every encoder.
+pub fn color_params(out: &mut Vec<u8>, c: Color, fg: bool) {
     let base: u8 = if fg { 30 } else { 40 };
     let _ = match c {
         Color::Rgb(r, g, b) => write!(out, "{};2;{r};{g};{b}", base + 8),
         Color::Indexed(n) => write!(out, "{};5;{n}", base + 8),
         Color::Reset => write!(out, "{}", base + 9),
         named => {
-            let i = ANSI16_ORDER.iter().position(|x| *x == named).unwrap_or(7) as u8;
+            let i = super::color::ansi16_index(named).unwrap_or(7);
             let code = if i < 8 { base + i } else { base + 60 + i - 8 };
             write!(out, "{code}")
         }
     };
 }
-
-/// The 16 named colours in palette order.
-const ANSI16_ORDER: [Color; 16] = [
-    Color::Black,
-    Color::Red,
-    Color::Green,
-    Color::Yellow,
-    Color::Blue,
-    Color::Magenta,
-    Color::Cyan,
-    Color::Gray,
-    Color::DarkGray,
-    Color::LightRed,
-    Color::LightGreen,
-    Color::LightYellow,
-    Color::LightBlue,
-    Color::LightMagenta,
-    Color::LightCyan,
-    Color::White,
-];
 
 /// Writes SGR for whichever of the two colours changed, in one sequence.
 fn set_colors(out: &mut Vec<u8>, cur: &mut (Color, Color), want: (Color, Color)) {
@@ -57,13 +38,13 @@ fn set_colors(out: &mut Vec<u8>, cur: &mut (Color, Color), want: (Color, Color))
     }
     out.extend_from_slice(b"\x1b[");
     if want.0 != cur.0 {
-        sgr(out, want.0, true);
+        color_params(out, want.0, true);
         if want.1 != cur.1 {
             out.push(b';');
         }
     }
     if want.1 != cur.1 {
-        sgr(out, want.1, false);
+        color_params(out, want.1, false);
     }
     out.push(b'm');
     *cur = want;

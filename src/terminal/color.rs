@@ -182,6 +182,12 @@ const ANSI16: [Color; 16] = [
     Color::White,
 ];
 
+/// The palette index (0–15) of one of the 16 named colours.
+#[must_use]
+pub fn ansi16_index(c: Color) -> Option<u8> {
+    ANSI16.iter().position(|x| *x == c).map(|i| i as u8)
+}
+
 fn dist2(a: Rgb, b: Rgb) -> i32 {
     (0..3)
         .map(|i| (i32::from(a[i]) - i32::from(b[i])).pow(2))

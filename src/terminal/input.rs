@@ -61,20 +61,24 @@ fn key(code: KeyCode, modifiers: KeyModifiers) -> Option<Input> {
     })))
 }
 
-/// Modifiers of an xterm modifier parameter (`1 + bits`: 1 shift, 2 alt, 4 ctrl).
-fn modifiers(param: u16) -> KeyModifiers {
-    let bits = param.saturating_sub(1);
+/// Modifiers of the bit field `v`, given the masks of its shift, alt and ctrl bits.
+fn modifiers_of(v: u16, [shift, alt, ctrl]: [u16; 3]) -> KeyModifiers {
     let mut m = KeyModifiers::NONE;
-    if bits & 1 != 0 {
-        m |= KeyModifiers::SHIFT;
-    }
-    if bits & 2 != 0 {
-        m |= KeyModifiers::ALT;
-    }
-    if bits & 4 != 0 {
-        m |= KeyModifiers::CONTROL;
+    for (bit, k) in [
+        (shift, KeyModifiers::SHIFT),
+        (alt, KeyModifiers::ALT),
+        (ctrl, KeyModifiers::CONTROL),
+    ] {
+        if v & bit != 0 {
+            m |= k;
+        }
     }
     m
+}
+
+/// Modifiers of an xterm modifier parameter (`1 + bits`: 1 shift, 2 alt, 4 ctrl).
+fn modifiers(param: u16) -> KeyModifiers {
+    modifiers_of(param.saturating_sub(1), [1, 2, 4])
 }
 
 /// The numeric parameters of a CSI sequence (`12;34` → [12, 34]); empty ones are 0.
@@ -150,16 +154,7 @@ fn mouse(p: &[u8], pressed: bool) -> Option<Input> {
     } else {
         MouseEventKind::Up(button)
     };
-    let mut modifiers = KeyModifiers::NONE;
-    if b & 4 != 0 {
-        modifiers |= KeyModifiers::SHIFT;
-    }
-    if b & 8 != 0 {
-        modifiers |= KeyModifiers::ALT;
-    }
-    if b & 16 != 0 {
-        modifiers |= KeyModifiers::CONTROL;
-    }
+    let modifiers = modifiers_of(b, [4, 8, 16]);
     Some(Input::Event(Event::Mouse(MouseEvent {
         kind,
         column: x.saturating_sub(1),

@@ -211,10 +211,10 @@ impl<W: Write> LinkBackend<W> {
             }
         }
         if cur.fg != p.fg {
-            sgr.color(p.fg, 30);
+            sgr.color(p.fg, true);
         }
         if cur.bg != p.bg {
-            sgr.color(p.bg, 40);
+            sgr.color(p.bg, false);
         }
         sgr.end();
         self.pen = Some(p);
@@ -241,30 +241,13 @@ impl<'a> Sgr<'a> {
         let _ = self.buf.write_fmt(p);
     }
 
-    /// A colour; `base` 30 for the foreground, 40 for the background.
-    fn color(&mut self, c: Color, base: u8) {
-        let named = |k: u8| base + k;
-        match c {
-            Color::Reset => self.param(format_args!("{}", named(9))),
-            Color::Black => self.param(format_args!("{}", named(0))),
-            Color::Red => self.param(format_args!("{}", named(1))),
-            Color::Green => self.param(format_args!("{}", named(2))),
-            Color::Yellow => self.param(format_args!("{}", named(3))),
-            Color::Blue => self.param(format_args!("{}", named(4))),
-            Color::Magenta => self.param(format_args!("{}", named(5))),
-            Color::Cyan => self.param(format_args!("{}", named(6))),
-            Color::Gray => self.param(format_args!("{}", named(7))),
-            Color::DarkGray => self.param(format_args!("{}", named(60))),
-            Color::LightRed => self.param(format_args!("{}", named(61))),
-            Color::LightGreen => self.param(format_args!("{}", named(62))),
-            Color::LightYellow => self.param(format_args!("{}", named(63))),
-            Color::LightBlue => self.param(format_args!("{}", named(64))),
-            Color::LightMagenta => self.param(format_args!("{}", named(65))),
-            Color::LightCyan => self.param(format_args!("{}", named(66))),
-            Color::White => self.param(format_args!("{}", named(67))),
-            Color::Indexed(i) => self.param(format_args!("{};5;{i}", named(8))),
-            Color::Rgb(r, g, b) => self.param(format_args!("{};2;{r};{g};{b}", named(8))),
+    /// A colour, in the foreground (`fg`) or background.
+    fn color(&mut self, c: Color, fg: bool) {
+        if !self.first {
+            self.buf.push(b';');
         }
+        self.first = false;
+        crate::terminal::ansi::color_params(self.buf, c, fg);
     }
 
     fn end(self) {

@@ -31,7 +31,7 @@ use crate::raster::setup::snap;
 use crate::raster::{CoverageSink, SUBPIXEL_BITS, Setup, Target, Traversal};
 use crate::simd::{F32s, I32s, each3};
 pub use isa::Isa;
-pub use target::{ColorTarget, Luma, Rgba8};
+pub use target::{ColorTarget, Rgba8};
 
 /// A shader: the vertex stage produces clip-space positions and varyings for vertex
 /// indices, the fragment stage a linear RGB colour from interpolated varyings. The

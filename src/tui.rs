@@ -23,6 +23,7 @@ pub mod viewport;
 use std::cell::Cell;
 use std::io::{self, IsTerminal, Read, Stdout, Write};
 use std::rc::Rc;
+use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
@@ -167,16 +168,41 @@ fn spawn_wakers() -> io::Result<mpsc::Receiver<Wake>> {
             for sig in signals.forever() {
                 let _ = tx.send(Wake::Signal(sig));
                 if ENDING.contains(&sig) {
-                    // The main thread leaves at once unless it is stuck writing to a
-                    // stalled terminal; then leave from here (no escape sequences: the
-                    // output is what is stuck).
-                    std::thread::sleep(Duration::from_millis(500));
-                    let _ = disable_raw_mode();
-                    std::process::exit(128 + sig);
+                    watchdog(sig);
                 }
             }
         })?;
     Ok(rx)
+}
+
+/// How far the main thread has got in leaving, for the watchdog.
+static LEAVING: AtomicU8 = AtomicU8::new(RUNNING);
+const RUNNING: u8 = 0;
+/// The main loop has returned; the terminal is being restored.
+const RESTORING: u8 = 1;
+/// The terminal is restored; the process is about to exit by itself.
+const RESTORED: u8 = 2;
+
+/// After an ending signal: the main thread leaves at once unless it is stuck writing
+/// to a stalled terminal; then this leaves for it, without escape sequences (the
+/// output is what is stuck). It ends the process with `_exit`, never `exit`: two
+/// threads running the C library's exit handlers at once can deadlock.
+fn watchdog(sig: i32) {
+    let start = Instant::now();
+    loop {
+        std::thread::sleep(Duration::from_millis(50));
+        let waited = start.elapsed();
+        let state = LEAVING.load(Ordering::Acquire);
+        // A main thread that is restoring gets longer: it is not stuck, only slow.
+        let patience = if state == RESTORING { 2000 } else { 500 };
+        if state == RESTORED {
+            return;
+        }
+        if waited >= Duration::from_millis(patience) {
+            let _ = disable_raw_mode();
+            signal_hook::low_level::exit(128 + sig);
+        }
+    }
 }
 
 fn enter(out: &mut impl Write) -> io::Result<()> {
@@ -195,7 +221,7 @@ pub fn run(mut app: App, options: RunOptions) -> Result<(), ViewError> {
         restore();
         previous(info);
     }));
-    let _guard = Guard;
+    let guard = Guard;
     enter(&mut io::stdout())?;
     let bytes = Rc::new(Cell::new(0));
     let writer = Counting {
@@ -214,7 +240,11 @@ pub fn run(mut app: App, options: RunOptions) -> Result<(), ViewError> {
         &mut pacer,
         &bytes,
     );
+    LEAVING.store(RESTORING, Ordering::Release);
     settle(&wakes, &mut parser, &mut pacer);
+    drop(terminal);
+    drop(guard);
+    LEAVING.store(RESTORED, Ordering::Release);
     result
 }
 

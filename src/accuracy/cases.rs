@@ -1,4 +1,4 @@
-//! Hard 2D cases for coverage: the stability suite (`tests/hard_cases.rs`) asserts the
+//! Hard 2D cases for coverage: the stability suite (`tests/it/hard_cases.rs`) asserts the
 //! exact variants on them and reports the float variants; `termrast bench accuracy`
 //! prints the same counts, so the suite and the table agree.
 

@@ -152,6 +152,28 @@ impl Varying for () {
     fn lerp(_: &Self, _: &Self, _: f32) -> Self {}
 }
 
+/// Packed attributes (a scene object's, laid out at run time): each float is
+/// interpolated as an `f32` varying is, so a packed `Vec3` gets the same bits as a
+/// `Vec3` varying.
+impl<const K: usize> Varying for [f32; K] {
+    #[inline(always)]
+    fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3] {
+        [
+            *a,
+            std::array::from_fn(|i| b[i] - a[i]),
+            std::array::from_fn(|i| c[i] - a[i]),
+        ]
+    }
+    #[inline(always)]
+    fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
+        std::array::from_fn(|i| r[2][i].mul_add(w[2], r[1][i].mul_add(w[1], r[0][i])))
+    }
+    #[inline(always)]
+    fn lerp(a: &Self, b: &Self, t: f32) -> Self {
+        std::array::from_fn(|i| a[i] + (b[i] - a[i]) * t)
+    }
+}
+
 impl<A: Varying, B: Varying> Varying for (A, B) {
     #[inline(always)]
     fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3] {

@@ -122,31 +122,6 @@ impl Shader for Lambert<'_> {
     }
 }
 
-/// Interpolates one attribute per vertex given by a closure and shows it as colour;
-/// used by tests to check interpolation against analytic references.
-pub struct Attribute<F> {
-    pub mvp: Mat4,
-    pub positions: Vec<Vec3>,
-    pub attr: F,
-}
-
-impl<F: Fn(u32) -> Vec3> Shader for Attribute<F> {
-    type Varying = Vec3;
-
-    fn vertex(&self, index: u32) -> (Vec4, Vec3) {
-        let p = self
-            .positions
-            .get(index as usize)
-            .copied()
-            .unwrap_or(Vec3::ZERO);
-        (self.mvp * p.extend(1.0), (self.attr)(index))
-    }
-
-    fn fragment(&self, v: &Vec3) -> Vec3 {
-        *v
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use glam::{Mat4, Vec3};

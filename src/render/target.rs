@@ -107,50 +107,11 @@ impl ColorTarget for Rgba8 {
     }
 }
 
-/// f32 luminance (Rec. 709 weights), what the terminal glyph ramps consume.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Luma(pub Vec<f32>);
-
 /// Rec. 709 luminance of a linear colour.
 #[must_use]
 #[inline(always)]
 pub fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
-
-impl ColorTarget for Luma {
-    #[inline(always)]
-    fn put(&mut self, index: usize, c: Vec3) {
-        self.0[index] = luminance(c);
-    }
-    fn reset(&mut self, len: usize, c: Vec3) {
-        self.0.clear();
-        crate::memory::reserve_frame(&mut self.0, len);
-        self.0.resize(len, luminance(c));
-    }
-}
-
-/// Writes both colour and luminance (the viewer needs both).
-impl<A: ColorTarget, B: ColorTarget> ColorTarget for (A, B) {
-    #[inline(always)]
-    fn put(&mut self, index: usize, c: Vec3) {
-        self.0.put(index, c);
-        self.1.put(index, c);
-    }
-    #[inline(always)]
-    fn put_lanes<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, c: &[F; 3]) {
-        self.0.put_lanes(start, stride, mask, c);
-        self.1.put_lanes(start, stride, mask, c);
-    }
-    #[inline(always)]
-    fn put_lanes_grey<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, g: F) {
-        self.0.put_lanes_grey(start, stride, mask, g);
-        self.1.put_lanes_grey(start, stride, mask, g);
-    }
-    fn reset(&mut self, len: usize, c: Vec3) {
-        self.0.reset(len, c);
-        self.1.reset(len, c);
-    }
 }
 
 #[cfg(test)]
@@ -159,7 +120,7 @@ mod tests {
     use proptest::prelude::*;
     use wide::f32x8;
 
-    use super::{ColorTarget, Luma, Rgba8};
+    use super::{ColorTarget, Rgba8};
     use crate::simd::{F32s, each3};
 
     /// The lane stores write exactly what `put` writes, lane by lane, and leave
@@ -196,19 +157,14 @@ mod tests {
         Ok(())
     }
 
-    /// [`check`] on every target type.
+    /// [`check`] on the colour target.
     fn check_targets<F: F32s>(
         rgb: &[Vec<f32>; 3],
         mask: u32,
         stride: usize,
     ) -> Result<(), TestCaseError> {
-        // Bit patterns, so NaN luminance compares equal to itself.
         let rgba = |c: &Rgba8| c.0.iter().map(|p| u32::from_le_bytes(*p)).collect();
-        let luma = |c: &Luma| c.0.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
-        check::<_, F>(Rgba8::default(), rgba, rgb, mask, stride)?;
-        check::<_, F>(Luma::default(), luma, rgb, mask, stride)?;
-        let both = |c: &(Rgba8, Luma)| [rgba(&c.0), luma(&c.1)].concat();
-        check::<_, F>((Rgba8::default(), Luma::default()), both, rgb, mask, stride)
+        check::<_, F>(Rgba8::default(), rgba, rgb, mask, stride)
     }
 
     /// A reset leaves every pixel the background, whatever the target held before and

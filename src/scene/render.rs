@@ -1,14 +1,12 @@
 //! Rendering a scene by its plan.
 //!
-//! Each object's varying set ([`VaryingSet`]) picks one of 16 pipelines when the scene
-//! is loaded: [`ObjectShader`] is generic over four slots (normal, world position,
-//! colour, uv), each [`On`] or [`Off`]. An `Off` slot's varying is `()`, so it is
-//! neither computed in the vertex stage nor interpolated per fragment, and the
-//! fragment code that reads it is compiled out. The choice is made once per object
-//! (a trait object per object, called once per frame); nothing is dispatched per
-//! vertex or pixel.
-
-use std::marker::PhantomData;
+//! An object's varyings are the attributes its plan needs ([`VaryingSet`]: normal,
+//! world position, colour, uv), packed into an array of floats by a [`Layout`]
+//! chosen when the scene is loaded. An attribute the plan leaves out is neither
+//! computed in the vertex stage nor read by the fragment stage. The draw loop is
+//! compiled for a few array widths ([`PACKED_WIDTHS`]), not for every attribute set,
+//! which keeps the build small. The choice is made once per object (a trait object
+//! per object, called once per frame); nothing is dispatched per vertex or pixel.
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
@@ -19,7 +17,6 @@ use crate::accuracy::area::grid_side;
 use crate::counters::{self, Stage};
 use crate::raster::Target;
 use crate::raster::depth::{DepthBuffer, DepthState};
-use crate::raster::interp::Varying;
 use crate::raster::probe::{Probe, probe_from};
 use crate::render::standard::WIRE_COLOR;
 use crate::render::wire::{WIRE_DEPTH_BIAS, draw_wireframe};
@@ -27,56 +24,66 @@ use crate::render::{
     Cull, DrawOptions, DrawStats, Renderer, Rgba8, Shader, VertexCache, transform,
 };
 
-/// A varying slot: present ([`On`]) or absent ([`Off`]) at compile time.
-pub trait Slot<T>: 'static {
-    type V: Varying;
-    const ON: bool;
-    /// The slot's varying; `f` runs only when the slot is on.
-    fn pack(f: impl FnOnce() -> T) -> Self::V;
-    /// The interpolated value (a default when off; code reading it is compiled out
-    /// behind `ON`).
-    fn get(v: &Self::V) -> T;
+/// Where an object's attributes sit in its packed varyings: the offset of each one
+/// its plan interpolates ([`VaryingSet`]), in floats.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Layout {
+    pub normal: Option<usize>,
+    pub position: Option<usize>,
+    pub color: Option<usize>,
+    pub uv: Option<usize>,
+    /// Floats in use.
+    pub len: usize,
 }
 
-/// A slot that is interpolated.
-#[derive(Debug)]
-pub struct On;
-/// A slot that does not exist.
-#[derive(Debug)]
-pub struct Off;
-
-impl<T: Varying> Slot<T> for On {
-    type V = T;
-    const ON: bool = true;
-    #[inline(always)]
-    fn pack(f: impl FnOnce() -> T) -> T {
-        f()
-    }
-    #[inline(always)]
-    fn get(v: &T) -> T {
-        *v
-    }
-}
-
-impl<T: Default> Slot<T> for Off {
-    type V = ();
-    const ON: bool = false;
-    #[inline(always)]
-    fn pack(_: impl FnOnce() -> T) {}
-    #[inline(always)]
-    fn get(_: &()) -> T {
-        T::default()
+impl Layout {
+    /// The attributes of `v`, packed in the order normal, position, colour, uv.
+    #[must_use]
+    pub fn new(v: VaryingSet) -> Self {
+        let mut len = 0;
+        let mut place = |on: bool, floats: usize| {
+            on.then(|| {
+                len += floats;
+                len - floats
+            })
+        };
+        let normal = place(v.normal, 3);
+        let position = place(v.position, 3);
+        let color = place(v.color, 3);
+        let uv = place(v.uv, 2);
+        Self {
+            normal,
+            position,
+            color,
+            uv,
+            len,
+        }
     }
 }
 
-/// The varyings of a pipeline: normal, position, colour, uv (nested pairs).
-pub type Varyings<N, P, C, U> = (
-    <N as Slot<Vec3>>::V,
-    (
-        <P as Slot<Vec3>>::V,
-        (<C as Slot<Vec3>>::V, <U as Slot<Vec2>>::V),
-    ),
-);
+/// The widths (floats) the pipelines are compiled for; an object takes the narrowest
+/// that holds its layout. Four widths instead of one pipeline per attribute set keep
+/// the build small, at the cost of at most three unused floats interpolated.
+pub const PACKED_WIDTHS: [usize; 4] = [0, 4, 8, 12];
+
+#[inline(always)]
+fn get3<const K: usize>(v: &[f32; K], at: Option<usize>) -> Option<Vec3> {
+    let s = v.get(at?..at? + 3)?;
+    Some(Vec3::new(s[0], s[1], s[2]))
+}
+
+#[inline(always)]
+fn get2<const K: usize>(v: &[f32; K], at: Option<usize>) -> Option<Vec2> {
+    let s = v.get(at?..at? + 2)?;
+    Some(Vec2::new(s[0], s[1]))
+}
+
+#[inline(always)]
+fn put<const K: usize>(v: &mut [f32; K], at: Option<usize>, x: &[f32]) {
+    if let Some(s) = at.and_then(|o| v.get_mut(o..o + x.len())) {
+        s.copy_from_slice(x);
+    }
+}
 
 /// What every object of a frame shares.
 #[derive(Clone, Copy, Debug)]
@@ -91,22 +98,24 @@ pub struct FrameCtx<'a> {
     pub time: f32,
 }
 
-/// The shader of one object in one of the 16 pipelines.
-pub struct ObjectShader<'a, N, P, C, U> {
+/// The shader of one object, its varyings packed in `K` floats by [`Layout`].
+pub struct ObjectShader<'a, const K: usize> {
     pub obj: &'a SceneObject,
     pub plan: &'a ObjectPlan,
     pub ctx: FrameCtx<'a>,
     pub model: Mat4,
     pub normal_matrix: Mat3,
     pub mvp: Mat4,
-    _slots: PhantomData<(N, P, C, U)>,
+    pub layout: Layout,
 }
 
-impl<'a, N, P, C, U> ObjectShader<'a, N, P, C, U> {
+impl<'a, const K: usize> ObjectShader<'a, K> {
     /// The shader for an object at this frame.
     #[must_use]
     pub fn new(obj: &'a SceneObject, plan: &'a ObjectPlan, ctx: FrameCtx<'a>) -> Self {
         let model = obj.desc.model_matrix(ctx.time);
+        let layout = Layout::new(plan.varyings);
+        debug_assert!(layout.len <= K);
         Self {
             obj,
             plan,
@@ -114,7 +123,7 @@ impl<'a, N, P, C, U> ObjectShader<'a, N, P, C, U> {
             model,
             normal_matrix: Mat3::from_mat4(model).inverse().transpose(),
             mvp: ctx.view_proj * model,
-            _slots: PhantomData,
+            layout,
         }
     }
 
@@ -154,20 +163,16 @@ impl<'a, N, P, C, U> ObjectShader<'a, N, P, C, U> {
     }
 }
 
-impl<N, P, C, U> Shader for ObjectShader<'_, N, P, C, U>
-where
-    N: Slot<Vec3>,
-    P: Slot<Vec3>,
-    C: Slot<Vec3>,
-    U: Slot<Vec2>,
-{
-    type Varying = Varyings<N, P, C, U>;
+impl<const K: usize> Shader for ObjectShader<'_, K> {
+    type Varying = [f32; K];
 
     fn vertex(&self, index: u32) -> (Vec4, Self::Varying) {
         let i = index as usize;
         let mesh = &self.obj.mesh;
         let p = mesh.positions.get(i).copied().unwrap_or(Vec3::ZERO);
         let plan = self.plan;
+        let layout = self.layout;
+        let mut out = [0.0; K];
         let world = if plan.world_positions {
             counters::add(Stage::PositionsToWorld, 1);
             self.model.transform_point3(p)
@@ -181,7 +186,9 @@ where
         } else {
             Vec3::ZERO
         };
-        let color = C::pack(|| {
+        put(&mut out, layout.normal, &normal.to_array());
+        put(&mut out, layout.position, &world.to_array());
+        if layout.color.is_some() {
             let mut c = Vec3::ONE;
             if plan.vertex_colors {
                 counters::add(Stage::VertexColors, 1);
@@ -195,22 +202,20 @@ where
                 };
                 c = self.light(normal, at, false, c);
             }
-            c
-        });
-        let uv = U::pack(|| {
+            put(&mut out, layout.color, &c.to_array());
+        }
+        if layout.uv.is_some() {
             counters::add(Stage::Uvs, 1);
-            mesh.uvs.get(i).copied().unwrap_or(Vec2::ZERO)
-        });
-        (
-            self.mvp * p.extend(1.0),
-            (N::pack(|| normal), (P::pack(|| world), (color, uv))),
-        )
+            let uv = mesh.uvs.get(i).copied().unwrap_or(Vec2::ZERO);
+            put(&mut out, layout.uv, &uv.to_array());
+        }
+        (self.mvp * p.extend(1.0), out)
     }
 
     fn fragment(&self, v: &Self::Varying) -> Vec3 {
-        let (n, (p, (c, uv))) = v;
         let plan = self.plan;
-        let world = P::get(p);
+        let layout = self.layout;
+        let world = get3(v, layout.position).unwrap_or(Vec3::ZERO);
         if plan.depth_shading {
             counters::add(Stage::DepthShading, 1);
             let (near, far) = self.ctx.depth_range;
@@ -219,14 +224,14 @@ where
         }
         let m = &self.obj.desc.material;
         let mut color = m.color;
-        if C::ON {
-            color *= C::get(c);
+        if let Some(c) = get3(v, layout.color) {
+            color *= c;
         }
-        if let (true, Some(t)) = (U::ON, &self.obj.texture) {
-            color *= t.sample(U::get(uv), plan.texture);
+        if let (Some(uv), Some(t)) = (get2(v, layout.uv), &self.obj.texture) {
+            color *= t.sample(uv, plan.texture);
         }
-        if N::ON {
-            color = self.light(N::get(n), world, m.lighting == Lighting::BlinnPhong, color);
+        if let Some(n) = get3(v, layout.normal) {
+            color = self.light(n, world, m.lighting == Lighting::BlinnPhong, color);
         }
         if let Some(fog) = self.obj.desc.effects.fog {
             counters::add(Stage::Fog, 1);
@@ -300,17 +305,13 @@ pub fn draw_options(plan: &ObjectPlan) -> DrawOptions {
     }
 }
 
-struct Pipeline<N: Slot<Vec3>, P: Slot<Vec3>, C: Slot<Vec3>, U: Slot<Vec2>> {
-    cache: VertexCache<Varyings<N, P, C, U>>,
+/// The pipeline of objects whose varyings fit `K` floats.
+struct Pipeline<const K: usize> {
+    cache: VertexCache<[f32; K]>,
+    varyings: VaryingSet,
 }
 
-impl<N, P, C, U> ObjectPipeline for Pipeline<N, P, C, U>
-where
-    N: Slot<Vec3>,
-    P: Slot<Vec3>,
-    C: Slot<Vec3>,
-    U: Slot<Vec2>,
-{
+impl<const K: usize> ObjectPipeline for Pipeline<K> {
     fn draw(
         &mut self,
         obj: &SceneObject,
@@ -319,7 +320,7 @@ where
         r: &mut Renderer,
         color: &mut Rgba8,
     ) {
-        let shader = ObjectShader::<N, P, C, U>::new(obj, plan, ctx);
+        let shader = ObjectShader::<K>::new(obj, plan, ctx);
         transform(&shader, obj.mesh.positions.len(), &mut self.cache);
         r.draw(
             &shader,
@@ -439,44 +440,25 @@ where
     }
 
     fn varyings(&self) -> VaryingSet {
-        VaryingSet {
-            normal: N::ON,
-            position: P::ON,
-            color: C::ON,
-            uv: U::ON,
-        }
+        self.varyings
     }
 }
 
-/// The pipeline compiled for a varying set.
+/// The pipeline for a varying set: the narrowest of [`PACKED_WIDTHS`] that holds it.
 #[must_use]
-pub fn pipeline_for(v: VaryingSet) -> Box<dyn ObjectPipeline> {
-    fn u<N: Slot<Vec3>, P: Slot<Vec3>, C: Slot<Vec3>>(v: VaryingSet) -> Box<dyn ObjectPipeline> {
-        if v.uv {
-            Box::new(Pipeline::<N, P, C, On> {
-                cache: VertexCache::default(),
-            })
-        } else {
-            Box::new(Pipeline::<N, P, C, Off> {
-                cache: VertexCache::default(),
-            })
-        }
+pub fn pipeline_for(varyings: VaryingSet) -> Box<dyn ObjectPipeline> {
+    fn new<const K: usize>(varyings: VaryingSet) -> Box<dyn ObjectPipeline> {
+        Box::new(Pipeline::<K> {
+            cache: VertexCache::default(),
+            varyings,
+        })
     }
-    fn c<N: Slot<Vec3>, P: Slot<Vec3>>(v: VaryingSet) -> Box<dyn ObjectPipeline> {
-        if v.color {
-            u::<N, P, On>(v)
-        } else {
-            u::<N, P, Off>(v)
-        }
+    match Layout::new(varyings).len {
+        0 => new::<0>(varyings),
+        1..=4 => new::<4>(varyings),
+        5..=8 => new::<8>(varyings),
+        _ => new::<12>(varyings),
     }
-    fn p<N: Slot<Vec3>>(v: VaryingSet) -> Box<dyn ObjectPipeline> {
-        if v.position {
-            c::<N, On>(v)
-        } else {
-            c::<N, Off>(v)
-        }
-    }
-    if v.normal { p::<On>(v) } else { p::<Off>(v) }
 }
 
 /// Where a scene is seen from in one frame.

@@ -7,9 +7,7 @@
 //! (`cargo test --test hard_cases -- --nocapture` prints them), and are the numbers
 //! the accuracy table shows.
 
-mod common;
-
-use common::{Direct, Exact, accumulate, assert_all_match_oracle, coverage, draw};
+use crate::common::{Direct, Exact, accumulate, assert_all_match_oracle, coverage, draw};
 use glam::{Vec3, Vec4};
 use proptest::prelude::*;
 use termrast::accuracy::cases;
@@ -25,9 +23,7 @@ use termrast::raster::line::{Line, NoTrace};
 use termrast::raster::probe::probe;
 use termrast::raster::traverse::seed_simd_lanes;
 use termrast::raster::{CountGrid, Reject, Setup, Target, Traversal};
-use termrast::render::{
-    ColorTarget, Cull, DrawOptions, Prepared, Renderer, Rgba8, VertexCache, prepare, transform,
-};
+use termrast::render::{Cull, DrawOptions, Prepared, Renderer, VertexCache, prepare, transform};
 
 const T: Target = Target {
     width: 96,
@@ -210,28 +206,14 @@ fn float_variants_on_the_hard_cases_are_reported() {
     }
 }
 
-/// A counting colour target: how many fragments were written to each pixel.
-#[derive(Default)]
-struct Writes(Vec<u32>);
-
-impl ColorTarget for Writes {
-    fn put(&mut self, i: usize, _: Vec3) {
-        self.0[i] += 1;
-    }
-    fn reset(&mut self, len: usize, _: Vec3) {
-        self.0.clear();
-        self.0.resize(len, 0);
-    }
-}
-
 /// Draws clip-space triangles with the depth test off: fragments per pixel.
-fn writes(clip: Vec<Vec4>, indices: &[u32], target: Target) -> Writes {
+fn writes(clip: Vec<Vec4>, indices: &[u32], target: Target) -> Vec<u32> {
     let shader = Direct {
         attr: vec![Vec3::ONE; clip.len()],
         clip,
     };
     let mut r = Renderer::new(target);
-    let mut out = Writes::default();
+    let mut out = Exact::default();
     let mut cache = VertexCache::default();
     r.begin_frame(target, &mut out, Vec3::ZERO);
     transform(&shader, shader.clip.len(), &mut cache);
@@ -243,7 +225,7 @@ fn writes(clip: Vec<Vec4>, indices: &[u32], target: Target) -> Writes {
         ..DrawOptions::default()
     };
     r.draw(&shader, &cache, indices, &opts, &mut out);
-    out
+    out.writes
 }
 
 /// Pass: a fan mesh through the whole 3D pipeline writes every pixel exactly once,
@@ -271,10 +253,10 @@ fn fans_through_the_pipeline_write_each_pixel_once() {
     };
     // Interior centre, ring well outside the view: the fan covers the target.
     let (clip, idx) = fan(Vec4::new(0.13, -0.07, 0.5, 1.0), ring(3.0, 37));
-    assert!(writes(clip, &idx, target).0.iter().all(|&c| c == 1));
+    assert!(writes(clip, &idx, target).iter().all(|&c| c == 1));
     // Ring out beyond the guard band (2^20 px): x, y clipped at the guard planes.
     let (clip, idx) = fan(Vec4::new(0.2, 0.1, 0.5, 1.0), ring(1.0e5, 29));
-    assert!(writes(clip, &idx, target).0.iter().all(|&c| c == 1));
+    assert!(writes(clip, &idx, target).iter().all(|&c| c == 1));
     // A planar fan (z = 0.6x + 0.2w) whose ring crosses the near plane: the radial
     // edges to the ring points behind it are clipped from both neighbouring
     // triangles. What remains is the convex part of the ring with NDC x ≥ −1/3, so
@@ -287,8 +269,8 @@ fn fans_through_the_pipeline_write_each_pixel_once() {
     assert!(ring.iter().any(|p| p.z < 0.0) && ring.iter().any(|p| p.z > 0.0));
     let (clip, idx) = fan(plane(0.1, 0.05, 1.0), ring);
     let w = writes(clip, &idx, target);
-    assert!(w.0.iter().all(|&c| c <= 1), "no double hits");
-    let at = |x: usize, y: usize| w.0[y * 64 + x];
+    assert!(w.iter().all(|&c| c <= 1), "no double hits");
+    let at = |x: usize, y: usize| w[y * 64 + x];
     let run_ok = |cells: Vec<u32>| {
         let first = cells.iter().position(|&c| c == 1);
         let last = cells.iter().rposition(|&c| c == 1);
@@ -316,7 +298,7 @@ fn fans_through_the_pipeline_write_each_pixel_once() {
             );
         }
     }
-    assert!(w.0.iter().filter(|&&c| c == 1).count() > 300);
+    assert!(w.iter().filter(|&&c| c == 1).count() > 300);
 }
 
 // ---------------------------------------------------------------------------------
@@ -380,7 +362,7 @@ fn clipping_a_polygon_rounding_made_non_convex_does_not_overflow() {
             ..DrawOptions::default()
         };
         let mut r = Renderer::new(target);
-        let mut color = Rgba8::default();
+        let mut color = Exact::default();
         let mut cache = VertexCache::default();
         r.begin_frame(target, &mut color, Vec3::ZERO);
         transform(&shader, 3, &mut cache);
@@ -430,14 +412,14 @@ fn vertices_beyond_the_guard_band_are_clipped_not_lost() {
             &DrawOptions::default(),
         );
         assert!(
-            img.0.iter().all(Option::is_some),
+            img.colors.iter().all(Option::is_some),
             "{far}: covers the target"
         );
         assert!(
             r.depth.to_vec().iter().all(|d| (d - 0.5).abs() < 1e-6),
             "{far}"
         );
-        for c in img.0.iter().flatten() {
+        for c in img.colors.iter().flatten() {
             assert!(c.is_finite());
         }
     }
@@ -484,7 +466,10 @@ fn nan_and_infinity_anywhere_are_discarded() {
                     &DrawOptions::default(),
                 );
                 assert_eq!(r.stats.rejected, 1, "{bad} in vertex {v} component {c}");
-                assert_eq!(img.0, reference.0, "{bad} in vertex {v} component {c}");
+                assert_eq!(
+                    img.colors, reference.colors,
+                    "{bad} in vertex {v} component {c}"
+                );
             }
         }
     }
@@ -565,7 +550,7 @@ fn vertices_behind_or_at_the_eye_never_leak() {
                 target,
                 &DrawOptions::default(),
             );
-            for (i, c) in img.0.iter().enumerate() {
+            for (i, c) in img.colors.iter().enumerate() {
                 if c.is_some() {
                     let d = r.depth.at(i);
                     assert!(
@@ -590,7 +575,7 @@ fn vertices_behind_or_at_the_eye_never_leak() {
             target,
             &DrawOptions::default(),
         );
-        assert!(img.0.iter().all(Option::is_none), "{name}");
+        assert!(img.colors.iter().all(Option::is_none), "{name}");
         assert_eq!(r.stats.rejected, 1);
     }
 }
@@ -634,9 +619,9 @@ fn near_plane_straddling_renders_exactly_the_front_part() {
         target,
         &DrawOptions::default(),
     );
-    let covered = |e: &Exact| e.0.iter().map(Option::is_some).collect::<Vec<_>>();
+    let covered = |e: &Exact| e.colors.iter().map(Option::is_some).collect::<Vec<_>>();
     assert_eq!(covered(&img), covered(&want));
-    for (g, w) in img.0.iter().zip(&want.0) {
+    for (g, w) in img.colors.iter().zip(&want.colors) {
         if let (Some(g), Some(w)) = (g, w) {
             assert!((*g - *w).abs().max_element() < 1e-5);
         }
@@ -857,21 +842,6 @@ fn any_f32() -> impl Strategy<Value = f32> {
     ]
 }
 
-/// A colour target that checks every write lands inside it.
-struct Bounded(Vec<u8>, usize);
-
-impl ColorTarget for Bounded {
-    fn put(&mut self, i: usize, c: Vec3) {
-        assert!(i < self.1, "write at {i} outside {}", self.1);
-        self.0[i] = u8::from(c.is_finite());
-    }
-    fn reset(&mut self, len: usize, _: Vec3) {
-        self.1 = len;
-        self.0.clear();
-        self.0.resize(len, 0);
-    }
-}
-
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(3000))]
 
@@ -888,14 +858,14 @@ proptest! {
         let clip: Vec<Vec4> = v.chunks(4).map(|c| Vec4::new(c[0], c[1], c[2], c[3])).collect();
         let shader = Direct { attr: vec![Vec3::X, Vec3::Y, Vec3::Z], clip };
         let mut r = Renderer::new(target);
-        let mut out = Bounded(Vec::new(), 0);
+        let mut out = Exact::default();
         let mut cache = VertexCache::default();
         r.begin_frame(target, &mut out, Vec3::ZERO);
         transform(&shader, 3, &mut cache);
         let opts = DrawOptions { traversal, ..DrawOptions::default() };
         r.draw(&shader, &cache, &[0, 1, 2, 2, 1, 0], &opts, &mut out);
         for (i, &d) in r.depth.to_vec().iter().enumerate() {
-            if out.0[i] != 0 {
+            if out.colors[i].is_some_and(|c| c.is_finite()) {
                 prop_assert!((0.0..=1.0).contains(&d), "depth {d}");
             }
         }

@@ -1,5 +1,4 @@
 //! Helpers shared by the integration tests.
-#![allow(dead_code)]
 
 use glam::{Vec3, Vec4};
 use termrast::raster::{CountGrid, CoverageSink, Setup, Target, Traversal, oracle};
@@ -80,17 +79,30 @@ pub fn accumulate(grid: &mut CountGrid, tri: [[f64; 2]; 3], t: Traversal) {
     }
 }
 
-/// A colour target that keeps exact f32 colours.
+/// A colour target that keeps exact f32 colours and counts the writes to each pixel;
+/// a write outside it fails the test. The tests draw into this one target (and
+/// `Rgba8`), so the draw loop is compiled for few target types.
 #[derive(Default)]
-pub struct Exact(pub Vec<Option<Vec3>>);
+pub struct Exact {
+    pub colors: Vec<Option<Vec3>>,
+    pub writes: Vec<u32>,
+}
 
 impl ColorTarget for Exact {
     fn put(&mut self, i: usize, c: Vec3) {
-        self.0[i] = Some(c);
+        assert!(
+            i < self.colors.len(),
+            "write at {i} outside {}",
+            self.colors.len()
+        );
+        self.colors[i] = Some(c);
+        self.writes[i] += 1;
     }
     fn reset(&mut self, len: usize, _: Vec3) {
-        self.0.clear();
-        self.0.resize(len, None);
+        self.colors.clear();
+        self.colors.resize(len, None);
+        self.writes.clear();
+        self.writes.resize(len, 0);
     }
 }
 

@@ -6,19 +6,9 @@ use termrast::raster::Target;
 use termrast::render::standard::{Model, StandardFrame, StandardView, WIRE_COLOR};
 use termrast::render::target::to_u8;
 use termrast::render::wire::{Mode, draw_wireframe, probe_lines, unique_edges};
-use termrast::render::{DrawOptions, Renderer, Rgba8, Shader, VertexCache, transform};
+use termrast::render::{DrawOptions, Renderer, Rgba8, VertexCache, transform};
 
-struct Direct(Vec<Vec4>);
-
-impl Shader for Direct {
-    type Varying = ();
-    fn vertex(&self, i: u32) -> (Vec4, ()) {
-        (self.0[i as usize], ())
-    }
-    fn fragment(&self, _: &()) -> Vec3 {
-        Vec3::splat(0.5)
-    }
-}
+use crate::common::Direct;
 
 #[test]
 fn shared_edges_are_drawn_once() {
@@ -52,7 +42,10 @@ fn hidden_lines_behind_a_face_are_removed() {
     };
     let mut verts = quad(0.5, 0.2).to_vec();
     verts.extend(quad(0.9, 0.8).map(|v| Vec4::new(v.x * 0.3, v.y * 1.1, v.z, v.w)));
-    let shader = Direct(verts);
+    let shader = Direct {
+        attr: vec![Vec3::splat(0.5); verts.len()],
+        clip: verts,
+    };
     let mut cache = VertexCache::default();
     transform(&shader, 8, &mut cache);
     let mut r = Renderer::new(target);

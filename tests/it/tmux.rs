@@ -67,14 +67,25 @@ impl Tmux {
     }
 
     fn wait_for(&self, needle: &str) -> String {
+        self.wait_until(|s| s.contains(needle))
+    }
+
+    /// The screen once `done` holds for it, or after ten seconds.
+    fn wait_until(&self, done: impl Fn(&str) -> bool) -> String {
         let start = Instant::now();
         loop {
             let s = self.screen();
-            if s.contains(needle) || start.elapsed() > Duration::from_secs(10) {
+            if done(&s) || start.elapsed() > Duration::from_secs(10) {
                 return s;
             }
             sleep(Duration::from_millis(100));
         }
+    }
+
+    /// The screen once the shell has printed the viewer's exit status (the `EXIT=`
+    /// in the typed command line does not count).
+    fn wait_for_exit(&self) -> String {
+        self.wait_until(|s| s.lines().any(|l| l.starts_with("EXIT=")))
     }
 
     /// alternate screen, mouse reporting, cursor visible.
@@ -112,7 +123,7 @@ impl Tmux {
 
     /// The viewer exited with `code` and left the terminal as it found it.
     fn assert_restored_with(&self, code: i32) {
-        let s = self.wait_for("EXIT=");
+        let s = self.wait_for_exit();
         assert!(
             s.contains(&format!("EXIT={code}")),
             "viewer did not exit with {code}:\n{s}"
@@ -309,7 +320,7 @@ fn a_dumb_terminal_gets_a_message_not_a_full_screen_interface() {
         env!("CARGO_BIN_EXE_termrast")
     );
     t.keys(&["clear", "Enter", &cmd, "Enter"]);
-    let s = t.wait_for("EXIT=");
+    let s = t.wait_for_exit();
     assert!(
         s.contains("TERM=dumb") && s.contains("termrast render"),
         "{s}"

@@ -1,9 +1,7 @@
 //! Coverage core: the four traversals against the i128 oracle and the fill rule.
 //! Watertight fans, drift, hostile and degenerate input are in `hard_cases.rs`.
 
-mod common;
-
-use common::{accumulate, assert_all_match_oracle, coverage, oracle_grid};
+use crate::common::{accumulate, assert_all_match_oracle, coverage, oracle_grid};
 use proptest::prelude::*;
 use termrast::raster::traverse::seed_simd_lanes;
 use termrast::raster::{CountGrid, Setup, Target, Traversal};

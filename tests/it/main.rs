@@ -1,0 +1,20 @@
+//! The integration tests, one module per topic. They are one test crate so that the
+//! draw loops they instantiate (their own shaders and colour targets) are compiled
+//! and linked once, not once per file.
+
+mod common;
+
+mod accuracy;
+mod cli_raster;
+mod coverage;
+mod framing;
+mod glyphs;
+mod hard_cases;
+mod lines;
+mod link;
+mod mesh;
+mod pipeline;
+mod scenes;
+mod terminal;
+mod tmux;
+mod wire;

@@ -3,6 +3,7 @@
 //! The binary calls [`main`]; everything here is library code so the tests can drive it.
 
 pub mod accuracy_cmd;
+pub mod bytes_cmd;
 pub mod effects_cmd;
 pub mod fidelity_cmd;
 pub mod line_cmd;
@@ -68,6 +69,10 @@ pub enum BenchCommand {
     /// The viewer behind a slow link (a pseudo-terminal drained at a set rate through
     /// a 2 MB buffer into a terminal emulator): key-to-screen time and frame rate.
     Link(link_cmd::LinkArgs),
+    /// Bytes per frame of the spinning viewer through its cell cache, against sending
+    /// every changed cell, and what the cache costs the eye (SSIM through a terminal
+    /// emulator), for every glyph mode and colour depth.
+    Bytes(bytes_cmd::BytesArgs),
 }
 
 /// Errors of the commands, each naming what it is about.
@@ -91,6 +96,8 @@ pub enum CliError {
     Link(#[from] crate::slowlink::LinkError),
     #[error(transparent)]
     Io(#[from] io::Error),
+    #[error("{0}")]
+    Usage(String),
 }
 
 /// Parses `WxH` (e.g. `80x24`) into a target size.
@@ -168,6 +175,9 @@ pub fn main() -> ExitCode {
         }
         Some(Command::Bench(BenchCommand::Link(args))) => {
             link_cmd::run(&args, &mut io::stdout().lock())
+        }
+        Some(Command::Bench(BenchCommand::Bytes(args))) => {
+            bytes_cmd::run(&args, &mut io::stdout().lock())
         }
         Some(Command::View(args)) => view_cmd::view(&args),
         None => view_cmd::view(&cli.view),

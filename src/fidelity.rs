@@ -17,6 +17,7 @@ pub mod config;
 pub mod metrics;
 pub mod reference;
 pub mod report;
+pub mod spin;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -282,6 +282,10 @@ fn draw(
     bytes: &Cell<u64>,
 ) -> io::Result<()> {
     let start_bytes = bytes.get();
+    let size = terminal.size()?;
+    let backend = terminal.backend_mut();
+    backend.bulk = app.model_area(ratatui::layout::Rect::new(0, 0, size.width, size.height));
+    backend.budget = pacer.budget(Instant::now());
     queue!(terminal.backend_mut(), BeginSynchronizedUpdate)?;
     let t0 = Instant::now();
     let mut render_time = Duration::ZERO;
@@ -341,6 +345,7 @@ fn main_loop(
                 rtt: pacer.rtt,
                 delivered_fps: pacer.delivered_fps(now),
                 unpaced: pacer.unpaced && pacer.wants_query(),
+                budget: pacer.budget(now),
             };
             draw(app, terminal, pacer, bytes)?;
             if !app.paused && frame_time > Duration::ZERO {

@@ -74,6 +74,8 @@ pub struct LinkStatus {
     pub delivered_fps: f32,
     /// The terminal does not answer queries: frames are not paced.
     pub unpaced: bool,
+    /// Bytes a frame may take while the link holds frames back.
+    pub budget: Option<usize>,
 }
 
 /// A scene in the viewer: what it is, its pipelines and buffers, and its time.
@@ -83,6 +85,18 @@ pub struct SceneState {
     pub frame: SceneFrame,
     /// Seconds of animation (stops while paused).
     pub time: f32,
+}
+
+/// The viewer's layout.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Areas {
+    /// Everything above the status line.
+    pub main: Rect,
+    /// The model.
+    pub view: Rect,
+    /// The inspector panel (empty when closed).
+    pub panel: Rect,
+    pub status: Rect,
 }
 
 impl App {
@@ -291,6 +305,33 @@ impl App {
         true
     }
 
+    /// Where everything goes on a screen of `area`.
+    #[must_use]
+    pub fn areas(&self, area: Rect) -> Areas {
+        let [main, status] =
+            Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(area);
+        let show_panel = self.inspect && main.width >= MIN_COLS + PANEL_COLS;
+        let [view, panel] = if show_panel {
+            Layout::horizontal([Constraint::Min(1), Constraint::Length(PANEL_COLS)]).areas(main)
+        } else {
+            [main, Rect::default()]
+        };
+        Areas {
+            main,
+            view,
+            panel,
+            status,
+        }
+    }
+
+    /// The model's part of a screen of `area` when nothing covers it (help and plan
+    /// overlays do): what may be sent in part over a slow link.
+    #[must_use]
+    pub fn model_area(&self, area: Rect) -> Option<Rect> {
+        (!self.help && !self.show_plan && area.width >= MIN_COLS && area.height >= MIN_ROWS)
+            .then(|| self.areas(area).view)
+    }
+
     /// Renders the model for the current layout and draws everything.
     pub fn draw(&mut self, f: &mut Frame) {
         let area = f.area();
@@ -302,14 +343,13 @@ impl App {
             f.render_widget(Paragraph::new(msg).wrap(Wrap { trim: true }), area);
             return;
         }
-        let [main, status] =
-            Layout::vertical([Constraint::Min(1), Constraint::Length(1)]).areas(area);
-        let show_panel = self.inspect && main.width >= MIN_COLS + PANEL_COLS;
-        let [view, panel] = if show_panel {
-            Layout::horizontal([Constraint::Min(1), Constraint::Length(PANEL_COLS)]).areas(main)
-        } else {
-            [main, Rect::default()]
-        };
+        let Areas {
+            main,
+            view,
+            panel,
+            status,
+        } = self.areas(area);
+        let show_panel = panel != Rect::default();
         self.view_area = view;
         match &mut self.scene {
             Some(s) => self.viewport.render_scene(
@@ -464,6 +504,9 @@ impl App {
                 );
             }
             None => {}
+        }
+        if let Some(b) = l.budget {
+            let _ = write!(self.status, " {:.1} kB/frame", b as f64 / 1e3);
         }
         self.status.push_str(" | ? help");
         if let Some(sc) = &self.scene {

@@ -7,17 +7,25 @@
 //! the screen never strays further than that from the true frame. A cell that did not
 //! change in this frame but is shown only approximately is sent exactly, so a still
 //! model shows the exact frame one frame after it stops. Colours are written only
-//! when they change (foreground and background apart), and the cursor moves by the
-//! shortest sequence. Everything is written to the terminal in one write per frame.
+//! when they change (foreground and background apart; the foreground of a space and
+//! the background of a full block are never written, since they do not show), a
+//! changed cell keeps the pen's colour when that is within the threshold, and the
+//! cursor moves by the shortest sequence. Everything is written to the terminal in
+//! one write per frame.
+//!
+//! On a link too slow for every change ([`LinkBackend::budget`]), the cells outside
+//! the model's area ([`LinkBackend::bulk`]: the status line, panels, overlays) go
+//! first and in full, then the model's most visible changes up to the budget; the rest
+//! follow in later frames.
 
 use std::io::{self, Write};
 
 use ratatui::backend::{Backend, ClearType, WindowSize};
 use ratatui::buffer::Cell;
-use ratatui::layout::{Position, Size};
+use ratatui::layout::{Position, Rect, Size};
 use ratatui::style::{Color, Modifier};
 
-use crate::terminal::color::delta_e;
+use crate::terminal::color::{Rgb, delta_e, indexed_rgb, nearest_256};
 
 /// How far (OKLab distance) a changed cell's colour may stray from the true frame.
 pub const DELTA_E: f32 = 0.04;
@@ -57,6 +65,15 @@ pub struct LinkBackend<W: Write> {
     fixed: Option<Size>,
     /// Colour threshold in use ([`DELTA_E`], or 0 to send every change).
     pub threshold: f32,
+    /// The part of the screen that may be sent in part when the budget is short (the
+    /// model); everything else is sent first, in full.
+    pub bulk: Option<Rect>,
+    /// Bytes the next frame may take, if limited.
+    pub budget: Option<usize>,
+    /// Bulk cells waiting to be sent, with how visible their change is.
+    candidates: Vec<(f32, u32)>,
+    /// Mean bytes per bulk cell sent, to fit the budget.
+    cell_bytes: f32,
 }
 
 impl<W: Write> LinkBackend<W> {
@@ -84,6 +101,10 @@ impl<W: Write> LinkBackend<W> {
             pen: None,
             fixed,
             threshold: DELTA_E,
+            bulk: None,
+            budget: None,
+            candidates: Vec::new(),
+            cell_bytes: 12.0,
         };
         let s = b.size().unwrap_or(Size::new(80, 24));
         b.reset(s);
@@ -111,48 +132,130 @@ impl<W: Write> LinkBackend<W> {
         self.hidden = None;
     }
 
-    /// Whether the shown cell `s` stands for the wanted `w` closely enough.
-    fn close_enough(&self, s: &Cell, w: &Cell) -> bool {
+    /// Whether the shown cell `s` stands for the wanted `w` closely enough: exactly,
+    /// or within the threshold if `approx`.
+    fn close_enough(&self, s: &Cell, w: &Cell, approx: bool) -> bool {
         if s.symbol() != w.symbol() || s.modifier != w.modifier {
             return false;
         }
-        let near = |a: Color, b: Color| match (a, b) {
-            _ if a == b => true,
-            (Color::Rgb(r0, g0, b0), Color::Rgb(r1, g1, b1)) => {
-                delta_e([r0, g0, b0], [r1, g1, b1]) <= self.threshold
-            }
-            _ => false,
-        };
-        near(s.fg, w.fg) && near(s.bg, w.bg)
+        let near =
+            |a: Color, b: Color| a == b || (approx && color_distance(a, b) <= self.threshold);
+        let (fg, bg) = shows(w);
+        (!fg || near(s.fg, w.fg)) && (!bg || near(s.bg, w.bg))
     }
 
-    /// Appends what takes the terminal from `shown` to `wanted`.
-    fn encode(&mut self) {
-        let cols = usize::from(self.cols);
-        for i in 0..self.wanted.len() {
-            let (w, s) = (&self.wanted[i], &self.shown[i]);
-            if w == s || (self.changed[i] && self.close_enough(s, w)) {
-                self.changed[i] = false;
-                continue;
-            }
-            self.changed[i] = false;
-            let (x, y) = ((i % cols) as u16, (i / cols) as u16);
-            if w.symbol().is_empty() {
-                // The trailing half of a wide character: drawn by the cell before it.
-                self.shown[i] = w.clone();
-                continue;
-            }
-            self.move_to(x, y);
-            let w = self.wanted[i].clone();
-            self.set_pen(Pen {
-                fg: w.fg,
-                bg: w.bg,
-                modifier: w.modifier,
-            });
-            self.buf.extend_from_slice(w.symbol().as_bytes());
-            self.cursor = narrow(w.symbol()).then_some((x + 1, y));
-            self.shown[i] = w;
+    /// How visible sending cell `i` would be: a changed glyph by its contrast, else by
+    /// how far its colours move.
+    fn visibility(&self, i: usize) -> f32 {
+        let (w, s) = (&self.wanted[i], &self.shown[i]);
+        if s.symbol() != w.symbol() || s.modifier != w.modifier {
+            return 1.0 + color_distance(w.fg, w.bg).min(1.0);
         }
+        color_distance(s.fg, w.fg).max(color_distance(s.bg, w.bg))
+    }
+
+    /// Whether cell `i` must be sent.
+    fn pending(&self, i: usize) -> bool {
+        !self.close_enough(&self.shown[i], &self.wanted[i], self.changed[i])
+    }
+
+    fn in_bulk(&self, i: usize) -> bool {
+        let cols = usize::from(self.cols);
+        let (x, y) = ((i % cols) as u16, (i / cols) as u16);
+        self.bulk.is_some_and(|r| r.contains(Position { x, y }))
+    }
+
+    /// Appends what takes the terminal from `shown` to `wanted`, within the budget.
+    fn encode(&mut self) {
+        let start = self.buf.len();
+        let n = self.wanted.len();
+        for i in 0..n {
+            if !self.in_bulk(i) && self.pending(i) {
+                self.send(i);
+            }
+        }
+        let mut candidates = std::mem::take(&mut self.candidates);
+        candidates.clear();
+        candidates.extend(
+            (0..n)
+                .filter(|&i| self.in_bulk(i) && self.pending(i))
+                .map(|i| (0.0, i as u32)),
+        );
+        let room = self
+            .budget
+            .map(|b| b.saturating_sub(self.buf.len() - start));
+        let fits = room.is_none_or(|r| candidates.len() as f32 * self.cell_bytes <= r as f32);
+        if !fits {
+            // The most visible changes that fit, sent in screen order.
+            for c in &mut candidates {
+                c.0 = self.visibility(c.1 as usize);
+            }
+            let k = (room.unwrap_or(0) as f32 / self.cell_bytes) as usize;
+            let k = k.clamp(1, candidates.len());
+            candidates.select_nth_unstable_by(k - 1, |a, b| b.0.total_cmp(&a.0));
+            candidates.truncate(k);
+            candidates.sort_unstable_by_key(|c| c.1);
+        }
+        let bulk_start = self.buf.len();
+        let mut sent = 0usize;
+        for &(_, i) in &candidates {
+            if !fits && self.buf.len() - start >= self.budget.unwrap_or(usize::MAX) {
+                break;
+            }
+            self.send(i as usize);
+            sent += 1;
+        }
+        if sent > 0 {
+            let mean = (self.buf.len() - bulk_start) as f32 / sent as f32;
+            self.cell_bytes = 0.8 * self.cell_bytes + 0.2 * mean.max(1.0);
+        }
+        self.candidates = candidates;
+        self.changed.fill(false);
+    }
+
+    /// Sends cell `i`.
+    fn send(&mut self, i: usize) {
+        let cols = usize::from(self.cols);
+        let (x, y) = ((i % cols) as u16, (i / cols) as u16);
+        let mut w = self.wanted[i].clone();
+        if w.symbol().is_empty() {
+            // The trailing half of a wide character: drawn by the cell before it.
+            self.shown[i] = w;
+            return;
+        }
+        self.move_to(x, y);
+        // Keep what the pen has where it does not show, or (for a changed cell) where
+        // it is within the threshold.
+        if let Some(pen) = self.pen.filter(|p| p.modifier == w.modifier) {
+            let (fg, bg) = shows(&w);
+            let near =
+                |a: Color, b: Color| self.changed[i] && color_distance(a, b) <= self.threshold;
+            if !fg || near(pen.fg, w.fg) {
+                w.fg = pen.fg;
+            }
+            if !bg || near(pen.bg, w.bg) {
+                w.bg = pen.bg;
+            }
+        }
+        if self.changed[i] {
+            // A palette colour within the threshold is written in half the bytes.
+            for c in [&mut w.fg, &mut w.bg] {
+                if let Color::Rgb(r, g, b) = *c {
+                    let n = nearest_256([r, g, b]);
+                    if delta_e(indexed_rgb(n), [r, g, b]) <= self.threshold {
+                        *c = Color::Indexed(n);
+                    }
+                }
+            }
+        }
+        self.set_pen(Pen {
+            fg: w.fg,
+            bg: w.bg,
+            modifier: w.modifier,
+        });
+        self.buf.extend_from_slice(w.symbol().as_bytes());
+        self.cursor = narrow(w.symbol()).then_some((x + 1, y));
+        self.shown[i] = w;
     }
 
     /// The shortest move of the cursor to `(x, y)`.
@@ -168,6 +271,7 @@ impl<W: Write> LinkBackend<W> {
                 }
             }
             Some((_, cy)) if x == 0 && y == cy + 1 => self.buf.extend_from_slice(b"\r\n"),
+            _ if (x, y) == (0, 0) => self.buf.extend_from_slice(b"\x1b[H"),
             _ if x == 0 => {
                 let _ = write!(self.buf, "\x1b[{}H", y + 1);
             }
@@ -218,6 +322,39 @@ impl<W: Write> LinkBackend<W> {
         }
         sgr.end();
         self.pen = Some(p);
+    }
+}
+
+/// Whether a cell's foreground and background show: a plain space shows no
+/// foreground, a plain full block no background.
+fn shows(c: &Cell) -> (bool, bool) {
+    let plain = c.modifier.is_empty();
+    match c.symbol() {
+        " " if plain => (false, true),
+        "█" if plain => (true, false),
+        _ => (true, true),
+    }
+}
+
+/// The RGB value of a colour whose value is fixed: RGB, or the xterm palette's cube
+/// and grey ramp (16–255, which terminals do not redefine in practice; the 16 ANSI
+/// colours they do).
+fn fixed_rgb(c: Color) -> Option<Rgb> {
+    match c {
+        Color::Rgb(r, g, b) => Some([r, g, b]),
+        Color::Indexed(i) if i >= 16 => Some(indexed_rgb(i)),
+        _ => None,
+    }
+}
+
+/// OKLab distance of two colours; 0 when equal, 1 (far) when either has no fixed value.
+fn color_distance(a: Color, b: Color) -> f32 {
+    if a == b {
+        return 0.0;
+    }
+    match (fixed_rgb(a), fixed_rgb(b)) {
+        (Some(a), Some(b)) => delta_e(a, b),
+        _ => 1.0,
     }
 }
 

@@ -5,6 +5,7 @@
 mod common;
 
 mod accuracy;
+mod bytes;
 mod cli_raster;
 mod coverage;
 mod framing;

@@ -4,7 +4,7 @@ use ratatui::buffer::Cell;
 use ratatui::style::{Color, Modifier};
 
 use super::LinkBackend;
-use crate::terminal::color::delta_e;
+use crate::terminal::color::{delta_e, indexed_rgb};
 
 const COLS: u16 = 12;
 const ROWS: u16 = 5;
@@ -44,6 +44,7 @@ fn draw(t: &mut Terminal<LinkBackend<Vec<u8>>>, frame: &Frame) -> Vec<u8> {
 fn rgb(c: vt100::Color) -> Option<[u8; 3]> {
     match c {
         vt100::Color::Rgb(r, g, b) => Some([r, g, b]),
+        vt100::Color::Idx(i) if i >= 16 => Some(indexed_rgb(i)),
         _ => None,
     }
 }
@@ -58,10 +59,17 @@ fn screen_error(p: &vt100::Parser, frame: &Frame) -> Result<f32, String> {
         if cell.contents() != ch.to_string() || cell.inverse() != rev {
             return Err(format!("({x},{y}) shows {:?}, not {ch:?}", cell.contents()));
         }
-        let (Some(f), Some(b)) = (rgb(cell.fgcolor()), rgb(cell.bgcolor())) else {
-            return Err(format!("({x},{y}) lost its colours"));
-        };
-        worst = worst.max(delta_e(f, fg)).max(delta_e(b, bg));
+        // A plain space shows no foreground, a plain full block no background.
+        let shows_fg = rev || ch != ' ';
+        let shows_bg = rev || ch != '█';
+        if shows_fg {
+            let f = rgb(cell.fgcolor()).ok_or(format!("({x},{y}) lost its foreground"))?;
+            worst = worst.max(delta_e(f, fg));
+        }
+        if shows_bg {
+            let b = rgb(cell.bgcolor()).ok_or(format!("({x},{y}) lost its background"))?;
+            worst = worst.max(delta_e(b, bg));
+        }
     }
     Ok(worst)
 }
@@ -108,4 +116,73 @@ fn small_colour_changes_are_not_sent_and_big_ones_are() {
     assert!(!draw(&mut t, &frame(101)).is_empty());
     assert!(draw(&mut t, &frame(101)).is_empty());
     assert!(draw(&mut t, &frame(200)).len() > n);
+}
+
+/// One changed cell costs its move, one SGR sequence with only what changed, and the
+/// glyph; a space's foreground is never written.
+#[test]
+fn sequences_are_minimal() {
+    let mut t = terminal(0.0);
+    let n = usize::from(COLS * ROWS);
+    let mut frame: Frame = vec![('a', [1, 2, 3], [4, 5, 6], false); n];
+    draw(&mut t, &frame);
+    frame[2 * usize::from(COLS) + 5].1 = [7, 8, 9];
+    assert_eq!(draw(&mut t, &frame), b"\x1b[3;6H\x1b[38;2;7;8;9ma");
+    // Two neighbours: the second needs no move; the same pen, no SGR.
+    frame[2 * usize::from(COLS) + 6].1 = [7, 8, 9];
+    frame[2 * usize::from(COLS) + 5].2 = [4, 5, 7];
+    assert_eq!(
+        draw(&mut t, &frame),
+        b"\x1b[3;6H\x1b[48;2;4;5;7ma\x1b[48;2;4;5;6ma"
+    );
+    // A space on the same background: only the background would show.
+    frame[0] = (' ', [200, 0, 0], [4, 5, 6], false);
+    assert_eq!(draw(&mut t, &frame), b"\x1b[H ");
+}
+
+/// A frame over budget sends every cell outside the model's area, then the model's
+/// most visible changes within the budget; later frames send the rest, and the screen
+/// ends exact.
+#[test]
+fn a_budget_sends_the_status_first_and_the_most_visible_changes() {
+    let mut t = terminal(super::DELTA_E);
+    let n = usize::from(COLS * ROWS);
+    let cols = usize::from(COLS);
+    let nz = |v| std::num::NonZeroU16::new(v).unwrap();
+    let mut p = vt100::Parser::new(nz(ROWS), nz(COLS), 0);
+    let grey = |v: u8| ('▀', [v, v, v], [0, 0, 0], false);
+    let mut frame: Frame = vec![grey(40); n];
+    p.process(&draw(&mut t, &frame));
+    // The model is rows 0..4; the last row is the status line.
+    t.backend_mut().bulk = Some(ratatui::layout::Rect::new(0, 0, COLS, ROWS - 1));
+    t.backend_mut().budget = Some(60);
+    for (i, c) in frame.iter_mut().enumerate() {
+        // A slight change everywhere, a big one in one cell of the model.
+        *c = grey(if i == 7 { 250 } else { 60 });
+        if i >= n - cols {
+            c.0 = 's';
+        }
+    }
+    let bytes = draw(&mut t, &frame);
+    p.process(&bytes);
+    let screen = p.screen();
+    assert!(
+        (0..COLS).all(|x| screen.cell(ROWS - 1, x).unwrap().contents() == "s"),
+        "the status line is sent in full"
+    );
+    let big = screen.cell(0, 7).unwrap().fgcolor();
+    assert!(
+        rgb(big).is_some_and(|c| delta_e(c, [250; 3]) <= super::DELTA_E),
+        "the most visible change is sent: {big:?}"
+    );
+    // The status line went first; the model's part, after it, kept to the budget
+    // (less than a cell over: the last cell sent may cross it).
+    let model_part = bytes.len() - bytes.iter().rposition(|&b| b == b's').unwrap_or(0);
+    assert!(model_part <= 60 + 30, "model part {model_part} bytes");
+    // Still frames bring the rest, until the screen is exact.
+    for _ in 0..40 {
+        p.process(&draw(&mut t, &frame));
+    }
+    assert_eq!(screen_error(&p, &frame), Ok(0.0));
+    assert!(draw(&mut t, &frame).is_empty());
 }

@@ -331,6 +331,8 @@ fn main_loop(
     let mut next_frame = last;
     let mut last_frame = last;
     let mut dirty = true;
+    // Resumed from our own suspension, before its SIGCONT arrived.
+    let mut resumed = false;
     let ctrl_z = Event::Key(KeyEvent::new(KeyCode::Char('z'), KeyModifiers::CONTROL));
     while !app.quit {
         let now = Instant::now();
@@ -384,8 +386,11 @@ fn main_loop(
             }
             Some(Wake::Signal(signal_hook::consts::SIGTSTP)) => {
                 suspend(terminal, pacer)?;
+                resumed = true;
                 dirty = true;
             }
+            // The continue that ends our own suspension: already resumed.
+            Some(Wake::Signal(signal_hook::consts::SIGCONT)) if resumed => resumed = false,
             Some(Wake::Signal(signal_hook::consts::SIGCONT)) => {
                 resume(terminal, pacer)?;
                 dirty = true;
@@ -399,6 +404,7 @@ fn main_loop(
                 Input::DeviceAttributes => pacer.answered(now),
                 Input::Event(e) if e == ctrl_z => {
                     suspend(terminal, pacer)?;
+                    resumed = true;
                     dirty = true;
                 }
                 Input::Event(e) => dirty |= app.handle(&e),

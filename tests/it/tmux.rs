@@ -205,7 +205,7 @@ fn gone(pid: &str) -> bool {
 
 #[test]
 fn ending_signals_restore_the_terminal_and_set_the_exit_status() {
-    for (sig, code) in [("-TERM", 143), ("-QUIT", 131), ("-HUP", 129)] {
+    for (sig, code) in [("-TERM", 143), ("-INT", 130), ("-QUIT", 131), ("-HUP", 129)] {
         let Some(t) = Tmux::new("term") else {
             eprintln!("tmux not installed: skipping the terminal end-to-end test");
             return;
@@ -279,6 +279,15 @@ fn ctrl_z_suspends_and_fg_redraws() {
     t.keys(&["clear", "Enter", "fg", "Enter"]);
     let s = t.wait_for("fps |");
     assert!(s.contains("fps |"), "not redrawn after fg:\n{s}");
+    assert_eq!(t.flags(), "1 1 0");
+    // SIGTSTP from elsewhere (`kill -TSTP`) does the same.
+    t.signal("-TSTP");
+    let s = t.wait_for("Stopped");
+    assert!(s.contains("Stopped"), "not suspended by SIGTSTP:\n{s}");
+    assert_eq!(t.flags(), "0 0 1", "SIGTSTP left the terminal as the viewer had it");
+    t.keys(&["clear", "Enter", "fg", "Enter"]);
+    let s = t.wait_for("fps |");
+    assert!(s.contains("fps |"), "not redrawn after the second fg:\n{s}");
     assert_eq!(t.flags(), "1 1 0");
     t.keys(&["q"]);
     t.keys(&["echo EXIT=$?", "Enter"]);

@@ -197,48 +197,57 @@ impl Viewport {
         self.target
     }
 
-    /// Fits every cell's glyph and colours to its samples.
+    /// Fits every cell's glyph and colours to its samples, rows of cells shared out
+    /// among the CPU's cores (each cell's fit is independent of the others).
     fn fit_cells(&mut self) {
-        let (cols, rows) = (self.cols, self.rows);
+        use rayon::prelude::*;
+        let cols = usize::from(self.cols);
         let start = Instant::now();
-        self.cells.clear();
-        self.cells
-            .resize(usize::from(cols) * usize::from(rows), CellGlyph::default());
+        let mut cells = std::mem::take(&mut self.cells);
+        cells.clear();
+        cells.resize(cols * usize::from(self.rows), CellGlyph::default());
+        if cols > 0 {
+            let this = &*self;
+            cells
+                .par_chunks_mut(cols)
+                .enumerate()
+                .for_each(|(cy, row)| this.fit_row(cy, row));
+        }
+        self.cells = cells;
+        self.glyph_time = start.elapsed();
+    }
+
+    /// Fits cell row `cy` into `out`.
+    fn fit_row(&self, cy: usize, out: &mut [CellGlyph]) {
         let (mode, colors, space) = (
             self.settings.glyphs,
             self.settings.colors,
             self.settings.fit_space,
         );
+        let cols = out.len();
         if mode.dims() == (fit::SX as u32, fit::SY as u32) && colors != ColorMode::None {
             // The shape fit runs 8 cells at a time, in lanes, straight from the frame's
             // rows; a batch of empty cells (most of the background) is skipped.
             let w = self.target.width as usize;
-            for cy in 0..usize::from(rows) {
-                let row0 = cy * fit::SY * w;
-                for x0 in (0..usize::from(cols)).step_by(8) {
-                    let n = (usize::from(cols) - x0).min(8);
-                    let start = row0 + x0 * fit::SX;
-                    let sample_rows: [&[[u8; 4]]; fit::SY] = std::array::from_fn(|j| {
-                        let at = start + j * w;
-                        &self.color.0[at..at + n * fit::SX]
-                    });
-                    let i = cy * usize::from(cols) + x0;
-                    fit_cells8(mode, colors, space, sample_rows, &mut self.cells[i..i + n]);
-                }
+            let row0 = cy * fit::SY * w;
+            for x0 in (0..cols).step_by(8) {
+                let n = (cols - x0).min(8);
+                let start = row0 + x0 * fit::SX;
+                let sample_rows: [&[[u8; 4]]; fit::SY] = std::array::from_fn(|j| {
+                    let at = start + j * w;
+                    &self.color.0[at..at + n * fit::SX]
+                });
+                fit_cells8(mode, colors, space, sample_rows, &mut out[x0..x0 + n]);
             }
         } else {
             // One sample buffer filled in place: returning it by value per cell cost a
             // stalled wide copy of bytes just written one at a time.
             let mut s = [Sample::default(); GlyphMode::MAX_SAMPLES];
-            for cy in 0..rows {
-                for cx in 0..cols {
-                    let n = self.samples_into(cx, cy, &mut s);
-                    self.cells[usize::from(cy) * usize::from(cols) + usize::from(cx)] =
-                        fit_cell(mode, &s[..n], colors, space);
-                }
+            for (cx, cell) in out.iter_mut().enumerate() {
+                let n = self.samples_into(cx as u16, cy as u16, &mut s);
+                *cell = fit_cell(mode, &s[..n], colors, space);
             }
         }
-        self.glyph_time = start.elapsed();
     }
 
     /// The samples of cell `(cx, cy)`, row-major, and how many there are.

@@ -1,11 +1,17 @@
 //! Default framing: every built-in model and example scene, spinning, leaves at least
-//! one empty cell row and column on each side of the view at 80×24, 200×60 and 60×60.
+//! one empty cell row and column on each side of the view at 80×24, 200×60 and 60×60,
+//! at any cell aspect, and `render --out` leaves an empty pixel border at any size.
 
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 use ratatui::style::Color;
 use termrast::cli::view_cmd::load_model;
+use termrast::raster::Target;
+use termrast::render::standard::{StandardFrame, StandardView};
+use termrast::render::wire::Mode;
+use termrast::render::{DrawOptions, Rgba8};
 use termrast::scene::Scene;
+use termrast::scene::render::{SceneFrame, SceneView};
 use termrast::terminal::{ColorMode, GlyphMode};
 use termrast::tui::app::App;
 use termrast::tui::viewport::ViewSettings;
@@ -92,6 +98,89 @@ fn example_scenes_fit_the_view_as_they_spin() {
                     k as f32 * 1.7
                 );
             }
+        }
+    }
+}
+
+/// Other cell shapes (`--cell-aspect`) frame the model the same way.
+#[test]
+fn any_cell_aspect_keeps_the_margin() {
+    let model = load_model("bunny").unwrap();
+    for aspect in [0.35, 0.6, 1.0] {
+        let mut app = App::new(
+            model.clone(),
+            ViewSettings {
+                cell_aspect: aspect,
+                ..settings(GlyphMode::Blocks)
+            },
+        );
+        for (cols, rows) in SIZES {
+            let mut t = Terminal::new(TestBackend::new(cols, rows)).unwrap();
+            for k in 0..4 {
+                app.settings.angle = k as f32 * std::f32::consts::FRAC_PI_2;
+                t.draw(|f| app.draw(f)).unwrap();
+                let touched = touched_edges(&t);
+                assert!(
+                    touched.is_empty(),
+                    "cell aspect {aspect} at {cols}x{rows}: touches {touched:?}"
+                );
+            }
+        }
+    }
+}
+
+/// Whether a frame's outer rows and columns are all uncovered (alpha 0).
+fn border_is_clear(color: &Rgba8, target: Target) -> bool {
+    let (w, h) = (target.width as usize, target.height as usize);
+    let px = |x: usize, y: usize| color.0[y * w + x][3];
+    (0..w).all(|x| px(x, 0) == 0 && px(x, h - 1) == 0)
+        && (0..h).all(|y| px(0, y) == 0 && px(w - 1, y) == 0)
+}
+
+/// `render --out`: the model's bounding sphere fits images of any shape, and so do
+/// example scenes without a camera of their own.
+#[test]
+fn png_frames_keep_the_margin() {
+    let targets = [(320, 240), (240, 320), (100, 100), (900, 120)].map(|(w, h)| Target::new(w, h));
+    for spec in ["teapot", "bunny", "sphere:20000"] {
+        let model = load_model(spec).unwrap();
+        for target in targets {
+            for k in 0..4 {
+                let angle = k as f32 * std::f32::consts::FRAC_PI_2;
+                let mut frame = StandardFrame::new(target);
+                let mut color = Rgba8::default();
+                frame.draw(
+                    &model,
+                    &StandardView::framed(&model, 1.0, angle),
+                    target,
+                    &DrawOptions::default(),
+                    Mode::Fill,
+                    &mut color,
+                );
+                assert!(color.0.iter().any(|p| p[3] != 0), "{spec} not drawn at all");
+                assert!(
+                    border_is_clear(&color, target),
+                    "{spec} at {}x{}, angle {angle}: touches the edge",
+                    target.width,
+                    target.height
+                );
+            }
+        }
+    }
+    for path in [
+        "examples/scenes/minimal.toml",
+        "examples/scenes/lit-teapot.toml",
+    ] {
+        let scene = Scene::load(std::path::Path::new(path)).unwrap();
+        for target in targets {
+            let mut frame = SceneFrame::new(&scene);
+            frame.draw(&scene, target, &SceneView::default());
+            assert!(
+                border_is_clear(&frame.color, target),
+                "{path} at {}x{}: touches the edge",
+                target.width,
+                target.height
+            );
         }
     }
 }

@@ -284,7 +284,11 @@ fn ctrl_z_suspends_and_fg_redraws() {
     t.signal("-TSTP");
     let s = t.wait_for("Stopped");
     assert!(s.contains("Stopped"), "not suspended by SIGTSTP:\n{s}");
-    assert_eq!(t.flags(), "0 0 1", "SIGTSTP left the terminal as the viewer had it");
+    assert_eq!(
+        t.flags(),
+        "0 0 1",
+        "SIGTSTP left the terminal as the viewer had it"
+    );
     t.keys(&["clear", "Enter", "fg", "Enter"]);
     let s = t.wait_for("fps |");
     assert!(s.contains("fps |"), "not redrawn after the second fg:\n{s}");

@@ -68,7 +68,7 @@ pub fn run(args: &FidelityArgs, out: &mut impl Write) -> Result<(), super::CliEr
     let views = config.views.len();
     writeln!(
         out,
-        "fidelity at {}×{} cells ({}×{} px), mean over {views} view{}; * = best SSIM of its colour depth",
+        "fidelity at {}×{} cells ({}×{} px), mean over {views} view{}; * = best SSIM of its colour depth and palette",
         config.cols,
         config.rows,
         config.pixels().0,

@@ -155,3 +155,61 @@ pub fn write_ansi(vp: &Viewport, out: &mut impl Write) -> io::Result<()> {
         out,
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    use super::*;
+
+    /// `LookArgs` as the command line parses them.
+    #[derive(Parser)]
+    struct Look {
+        #[command(flatten)]
+        look: LookArgs,
+    }
+
+    fn look(args: &[&str]) -> LookArgs {
+        Look::parse_from(std::iter::once("termrast").chain(args.iter().copied())).look
+    }
+
+    fn env<'a>(vars: &'a [(&'a str, &'a str)]) -> impl Fn(&str) -> Option<String> + 'a {
+        move |k| {
+            vars.iter()
+                .find(|(n, _)| *n == k)
+                .map(|(_, v)| (*v).to_string())
+        }
+    }
+
+    #[test]
+    fn glyphs_given_override_the_ascii_of_a_non_utf8_locale() {
+        for vars in [
+            &[("LANG", "C"), ("TERM", "xterm-256color")][..],
+            &[("LC_ALL", "C"), ("LANG", "en_US.UTF-8")][..],
+            &[("LC_ALL", "POSIX"), ("TERM", "xterm-kitty")][..],
+        ] {
+            // Without --glyphs: ascii, and the status line says why, once.
+            let plain = look(&[]);
+            let s = plain.settings_in(Mode::Fill, false, env(vars));
+            assert_eq!(s.glyphs, GlyphMode::Ascii, "{vars:?}");
+            let notice = plain.notice_in(env(vars)).expect("a notice");
+            assert!(
+                notice.contains("not UTF-8") && notice.contains("--glyphs"),
+                "{notice}"
+            );
+            // With --glyphs blocks: blocks, and nothing to tell.
+            let given = look(&["--glyphs", "blocks"]);
+            let s = given.settings_in(Mode::Fill, false, env(vars));
+            assert_eq!(s.glyphs, GlyphMode::Blocks, "{vars:?}");
+            assert_eq!(given.notice_in(env(vars)), None, "{vars:?}");
+        }
+        // A UTF-8 locale keeps the default for the terminal and says nothing.
+        let utf8 = [("LANG", "en_US.UTF-8"), ("TERM", "xterm-256color")];
+        let plain = look(&[]);
+        assert_eq!(
+            plain.settings_in(Mode::Fill, false, env(&utf8)).glyphs,
+            GlyphMode::default_for(false)
+        );
+        assert_eq!(plain.notice_in(env(&utf8)), None);
+    }
+}

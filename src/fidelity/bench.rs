@@ -15,7 +15,7 @@ use super::reference::{self, ReferenceImages};
 use super::{FidelityError, save_png};
 use crate::render::standard::{Model, StandardView};
 use crate::terminal::glyphs::FitSpace;
-use crate::terminal::paint;
+use crate::terminal::paint::{self, Palette};
 use crate::terminal::{ColorMode, GlyphMode};
 use crate::tui::viewport::{ViewSettings, Viewport};
 
@@ -44,6 +44,8 @@ pub struct Measurement {
     /// termrast's glyph mode or chafa's symbol set.
     pub method: String,
     pub colors: ColorMode,
+    /// The palette the frame was painted with (see [`palettes`]).
+    pub palette: Palette,
     pub score: Score,
     /// Bytes of the frame's output.
     pub bytes: usize,
@@ -58,6 +60,21 @@ pub struct Measurement {
 pub struct Outcome {
     pub measurements: Vec<Measurement>,
     pub notes: Vec<String>,
+}
+
+/// The palettes a frame of `source` at depth `colors` is painted with: xterm's always,
+/// and chafa's too where the frame's colours depend on it. chafa fits its 16- and
+/// 256-colour output to its own 16 ANSI colours ([`paint::CHAFA_ANSI16`]; at 256
+/// colours it picks indices 0–15 where one is nearest), termrast its 16-colour output
+/// to xterm's, so each program is shown on the palette it assumes and on the other's.
+/// termrast's 256-colour frames use only the cube and grey ramp (16–255), which the
+/// palettes share.
+#[must_use]
+pub fn palettes(source: Source, colors: ColorMode) -> &'static [Palette] {
+    match (source, colors) {
+        (_, ColorMode::Ansi16) | (Source::Chafa, ColorMode::Ansi256) => &Palette::ALL,
+        _ => &[Palette::Xterm],
+    }
 }
 
 /// termrast's frame as the bytes a terminal receives: the one place the encoder is
@@ -137,6 +154,13 @@ pub fn run(config: &Config) -> Result<Outcome, FidelityError> {
         measurements.extend(o.measurements);
         notes.extend(o.notes);
     }
+    notes.push(
+        "palette: the 16 ANSI colours the indexed frames are painted with; `xterm` is \
+         xterm's (what termrast fits to), `chafa` is chafa's own (what it fits to: \
+         colour 7 #c0c0c0, 8 #404040, dim colours at #80/#70); the rest of the 256 \
+         are the same in both"
+            .into(),
+    );
     notes.extend(size_notes(config, &measurements));
     Ok(Outcome {
         measurements,
@@ -152,7 +176,10 @@ fn size_notes(config: &Config, ms: &[Measurement]) -> Vec<String> {
     let grid = (config.cols, config.rows);
     let mut notes = Vec::new();
     for source in [Source::Termrast, Source::Chafa] {
-        let of: Vec<_> = ms.iter().filter(|m| m.source == source).collect();
+        let of: Vec<_> = ms
+            .iter()
+            .filter(|m| m.source == source && m.palette == Palette::Xterm)
+            .collect();
         let wrong = |m: &&&Measurement| match source {
             Source::Termrast => m.printed.0 > grid.0 || m.printed.1 > grid.1,
             Source::Chafa => m.printed != grid,
@@ -197,36 +224,47 @@ struct Prepared {
     metric: metrics::Reference,
 }
 
-/// Scores one frame's bytes: emulated, painted and compared with the reference.
+/// Scores one frame's bytes on each of its [`palettes`]: emulated, painted and
+/// compared with the reference.
 fn measure(
     config: &Config,
     reference: &Prepared,
     bytes: &[u8],
     id: (&View, Source, &str, ColorMode),
-) -> Result<Measurement, FidelityError> {
+    out: &mut Vec<Measurement>,
+) -> Result<(), FidelityError> {
     let (view, source, method, colors) = id;
-    let grid = paint::emulate(bytes, config.cols, config.rows)?;
-    let painted = paint::paint(&grid)?;
-    let score = reference.metric.score(&painted.image)?;
-    if let Some(dir) = &config.keep {
-        let name = format!(
-            "{}-{}-{method}-{}",
-            view.name(),
-            source.name(),
-            colors.name()
-        );
-        save_png(&dir.join(file_name(&name)), &painted.image)?;
+    let printed = paint::printed_size(bytes, config.cols, config.rows)?;
+    for &palette in palettes(source, colors) {
+        let grid = paint::emulate_in(bytes, config.cols, config.rows, palette)?;
+        let painted = paint::paint(&grid)?;
+        let score = reference.metric.score(&painted.image)?;
+        if let Some(dir) = &config.keep {
+            let on = match palette {
+                Palette::Xterm => String::new(),
+                p => format!("-{}-palette", p.name()),
+            };
+            let name = format!(
+                "{}-{}-{method}-{}{on}",
+                view.name(),
+                source.name(),
+                colors.name()
+            );
+            save_png(&dir.join(file_name(&name)), &painted.image)?;
+        }
+        out.push(Measurement {
+            view: view.name(),
+            source,
+            method: method.to_owned(),
+            colors,
+            palette,
+            score,
+            bytes: bytes.len(),
+            unpainted: painted.unpainted,
+            printed,
+        });
     }
-    Ok(Measurement {
-        view: view.name(),
-        source,
-        method: method.to_owned(),
-        colors,
-        score,
-        bytes: bytes.len(),
-        unpainted: painted.unpainted,
-        printed: paint::printed_size(bytes, config.cols, config.rows)?,
-    })
+    Ok(())
 }
 
 /// Every mode as the viewer draws it, and the shape-fitted ones with their error
@@ -299,8 +337,7 @@ fn measure_view(
             };
             let bytes = encode(&vp).map_err(FidelityError::Encode)?;
             let id = (view, Source::Termrast, method.as_str(), colors);
-            out.measurements
-                .push(measure(config, &reference, &bytes, id)?);
+            measure(config, &reference, &bytes, id, &mut out.measurements)?;
             prepared = Some(reference);
         }
     }
@@ -364,8 +401,7 @@ fn measure_chafa(
             match chafa.convert(&input.path, config.cols, config.rows, set, colors) {
                 Ok(bytes) => {
                     let id = (view, Source::Chafa, set, colors);
-                    out.measurements
-                        .push(measure(config, reference, &bytes, id)?);
+                    measure(config, reference, &bytes, id, &mut out.measurements)?;
                 }
                 Err(e) => out.notes.push(format!("{}: {e}", view.name())),
             }
@@ -385,7 +421,11 @@ mod tests {
         let mut config = Config::new(20, 8, views).unwrap();
         config.chafa = false;
         let o = run(&config).unwrap();
-        let n = variants().count() * ColorMode::ALL.len();
+        let n = variants().count()
+            * ColorMode::ALL
+                .iter()
+                .map(|&c| palettes(Source::Termrast, c).len())
+                .sum::<usize>();
         assert_eq!(o.measurements.len(), n);
         for m in &o.measurements {
             let s = m.score.ssim;
@@ -400,5 +440,42 @@ mod tests {
             }
         }
         assert!(o.notes.iter().any(|n| n.contains("--no-chafa")));
+        // At 16 colours each frame is painted on both palettes: the same bytes, and
+        // termrast's frames (fitted to xterm's colours) score better on xterm's.
+        let on = |p: Palette| {
+            o.measurements
+                .iter()
+                .filter(move |m| m.colors == ColorMode::Ansi16 && m.palette == p)
+        };
+        assert_eq!(on(Palette::Xterm).count(), variants().count());
+        for (x, c) in on(Palette::Xterm).zip(on(Palette::Chafa)) {
+            assert_eq!((&x.method, x.bytes), (&c.method, c.bytes));
+            assert!(x.score.psnr > c.score.psnr, "{x:?} {c:?}");
+        }
+    }
+
+    #[test]
+    fn chafa_is_painted_on_its_own_palette_where_it_uses_one() {
+        for source in [Source::Termrast, Source::Chafa] {
+            assert_eq!(palettes(source, ColorMode::Truecolor), [Palette::Xterm]);
+            assert_eq!(palettes(source, ColorMode::None), [Palette::Xterm]);
+            assert_eq!(palettes(source, ColorMode::Ansi16), Palette::ALL);
+        }
+        assert_eq!(palettes(Source::Chafa, ColorMode::Ansi256), Palette::ALL);
+        assert_eq!(
+            palettes(Source::Termrast, ColorMode::Ansi256),
+            [Palette::Xterm]
+        );
+        // termrast's 256-colour frames never use the indices the palettes differ in.
+        for i in 0..=255u8 {
+            let c = ColorMode::Ansi256.color([i, i / 2, 255 - i]);
+            let grey = ColorMode::Ansi256.color([i; 3]);
+            for c in [c, grey] {
+                assert!(
+                    matches!(c, ratatui::style::Color::Indexed(n) if n >= 16),
+                    "{c:?}"
+                );
+            }
+        }
     }
 }

@@ -1,13 +1,15 @@
 //! The glyph fits against brute force, and what a terminal emulator shows of a frame:
-//! no braille dots over the default background where a cell is one colour.
+//! no braille dots over the default background where a cell is one colour, and colour
+//! ASCII as bright as the model.
 
 use proptest::prelude::*;
-use termrast::cli::view_cmd::write_ansi;
+use termrast::cli::view_cmd::{load_model, write_ansi};
 use termrast::scene::Scene;
 use termrast::scene::render::SceneFrame;
 use termrast::terminal::color::{to_linear, to_srgb};
 use termrast::terminal::fit::{self, N, Repertoire, mask_of, weights_of};
 use termrast::terminal::glyphs::{FitSpace, Sample, fit_cell};
+use termrast::terminal::paint::{self, CELL_HEIGHT, CELL_WIDTH};
 use termrast::terminal::{ColorMode, GlyphMode};
 use termrast::tui::viewport::{ViewSettings, Viewport};
 
@@ -263,6 +265,124 @@ fn uniform_cells_show_no_braille_over_the_default_background() {
         );
         if colors != ColorMode::None {
             assert_eq!(full, uniform, "{}", colors.name());
+        }
+    }
+}
+
+/// Relative luminance in linear light of an sRGB colour.
+fn luminance(c: [u8; 3]) -> f32 {
+    let l = c.map(to_linear);
+    0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2]
+}
+
+/// Colour ASCII as a terminal shows it, on a flat-shaded cube and the lit teapot: every
+/// cell inside the model has a background colour (the ASCII is not drawn over the
+/// terminal's black), and the bright cells paint as much light as the model's samples
+/// there (a foreground-only character inks a fraction of its cell: about a third of the
+/// brightness).
+#[test]
+fn colour_ascii_keeps_the_models_brightness() {
+    let text = "[[object]]\nmodel = \"cube.obj\"\nrotation = [30, 40, 0]\n\
+                [object.material]\nlighting = \"flat\"\n[object.effects]\ndepth_test = true\n";
+    let scene = Scene::from_text(text, std::path::Path::new("examples/scenes/flat.toml")).unwrap();
+    let teapot = load_model("teapot").unwrap();
+    for (name, fit_space) in [
+        ("flat cube", FitSpace::Srgb),
+        ("teapot", FitSpace::Srgb),
+        ("teapot", FitSpace::Linear),
+    ] {
+        let settings = ViewSettings {
+            glyphs: GlyphMode::Ascii,
+            colors: ColorMode::Truecolor,
+            fit_space,
+            ..ViewSettings::default()
+        };
+        let mut vp = Viewport::default();
+        if name == "teapot" {
+            vp.render(&teapot, &settings, 80, 24);
+        } else {
+            let mut frame = SceneFrame::new(&scene);
+            vp.render_scene(&scene, &mut frame, &settings, (80, 24), 0.7);
+        }
+        let term = emulate(&vp);
+        let mut bytes = Vec::new();
+        write_ansi(&vp, &mut bytes).unwrap();
+        let grid = paint::emulate(&bytes, vp.cols, vp.rows).unwrap();
+        let painted = paint::paint(&grid).unwrap();
+        assert_eq!(painted.unpainted, 0, "{name}");
+        let (mut inside, mut inked) = (0, 0);
+        // (model, shown) light of each bright cell inside the model.
+        let mut bright: Vec<(f32, f32, u16, u16)> = Vec::new();
+        for cy in 0..vp.rows {
+            for cx in 0..vp.cols {
+                let (s, n) = vp.samples(cx, cy);
+                let s = &s[..n];
+                if !s.iter().all(|x| x.covered) {
+                    continue;
+                }
+                inside += 1;
+                let cell = term.screen().cell(cy, cx).unwrap();
+                assert_ne!(
+                    cell.bgcolor(),
+                    vt100::Color::Default,
+                    "{name}: cell ({cx},{cy}) inside the model shows {:?} over the default background",
+                    cell.contents()
+                );
+                inked += usize::from(cell.contents().trim() != "");
+                let model = s.iter().map(|x| luminance(x.rgb)).sum::<f32>() / n as f32;
+                if model < 0.2 {
+                    continue;
+                }
+                let (x0, y0) = (u32::from(cx) * CELL_WIDTH, u32::from(cy) * CELL_HEIGHT);
+                let mut sum = 0.0;
+                for y in y0..y0 + CELL_HEIGHT {
+                    for x in x0..x0 + CELL_WIDTH {
+                        sum += luminance(painted.image.get_pixel(x, y).0);
+                    }
+                }
+                bright.push((model, sum / (CELL_WIDTH * CELL_HEIGHT) as f32, cx, cy));
+            }
+        }
+        assert!(
+            inside > 100 && bright.len() > 100,
+            "{name}: {inside} cells inside, {} bright",
+            bright.len()
+        );
+        // Over the bright area, the model's light within 3 %.
+        let model_light: f32 = bright.iter().map(|b| b.0).sum();
+        let shown_light: f32 = bright.iter().map(|b| b.1).sum();
+        let ratio = shown_light / model_light;
+        assert!(
+            (ratio - 1.0).abs() <= 0.03,
+            "{name} {fit_space:?}: the bright cells show {ratio:.3} of the model's light"
+        );
+        // Cell by cell: nine in ten within 5 %, and none far off. A fit in sRGB values
+        // darkens a cell whose samples spread widely (a highlight) by up to about a
+        // quarter; a fit in linear light keeps each cell's light.
+        let off = |b: &(f32, f32, u16, u16)| (b.1 / b.0 - 1.0).abs();
+        let close = bright.iter().filter(|b| off(b) <= 0.05).count();
+        assert!(
+            close * 10 >= bright.len() * 9,
+            "{name} {fit_space:?}: {close} of {} bright cells within 5 %",
+            bright.len()
+        );
+        let most = match fit_space {
+            FitSpace::Srgb => 0.35,
+            FitSpace::Linear => 0.1,
+        };
+        for b in &bright {
+            assert!(
+                off(b) <= most,
+                "{name} {fit_space:?}: cell ({},{}) shows {:.3} of the model's {:.3}",
+                b.2,
+                b.3,
+                b.1,
+                b.0
+            );
+        }
+        if name == "teapot" {
+            // Shading varies over the teapot, so characters are drawn, not only spaces.
+            assert!(inked > 100, "{name}: only {inked} cells inked");
         }
     }
 }

@@ -5,9 +5,9 @@
 //! Keys are pressed and the time until the emulated screen shows their effect is
 //! measured (Linux only: it needs `openpty`).
 //!
-//! The key is `i` (inspect mode on, then off): its effect is `inspect |` appearing in
-//! (or leaving) the status line, while the model keeps spinning, so every frame in the
-//! link's buffers stands between the key and its effect.
+//! The key is `b` (back-face culling on, then off): its effect is `cull` turning to
+//! `no cull` in the status line and back, while the model keeps spinning, so every
+//! frame in the link's buffers stands between the key and its effect.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -193,11 +193,12 @@ mod linux {
         n
     }
 
-    fn status_has_inspect(p: &vt100::Parser, rows: u16) -> bool {
+    /// Whether the emulated status line says culling is on.
+    fn status_says_cull(p: &vt100::Parser, rows: u16) -> bool {
         p.screen()
             .rows(0, 400)
             .nth(usize::from(rows - 1))
-            .is_some_and(|l| l.contains("inspect |"))
+            .is_some_and(|l| l.contains(" cull |") && !l.contains("no cull"))
     }
 
     /// Runs the viewer behind the link and times `config.presses` key presses.
@@ -285,22 +286,22 @@ mod linux {
         }
         let measure_from = Instant::now();
         let (delivered0, frames0) = (link.delivered, link.frames);
-        let mut inspect = false;
+        let mut cull = false;
         for _ in 0..config.presses {
             // Let the link fill with spinning frames before each press.
             let settle = Instant::now();
             while settle.elapsed() < Duration::from_millis(700) {
                 link.step(&mut parser, &mut writer)?;
             }
-            writer.write_all(b"i")?;
-            inspect = !inspect;
+            writer.write_all(b"b")?;
+            cull = !cull;
             let pressed = Instant::now();
             let mut seen = None;
             while pressed.elapsed() < config.timeout {
                 if link.step(&mut parser, &mut writer)? {
                     break;
                 }
-                if status_has_inspect(&parser, config.rows) == inspect {
+                if status_says_cull(&parser, config.rows) == cull {
                     seen = Some(pressed.elapsed());
                     break;
                 }

@@ -15,9 +15,12 @@
 //! read the frame: frames are paced by those answers ([`pacing`]).
 
 pub mod app;
+pub mod draw;
 pub mod inspector;
 pub mod link;
 pub mod pacing;
+pub mod panel;
+pub mod status;
 pub mod viewport;
 
 use std::cell::Cell;
@@ -230,6 +233,7 @@ pub fn run(mut app: App, options: RunOptions) -> Result<(), ViewError> {
     };
     let mut terminal = Terminal::new(link::LinkBackend::new(writer))?;
     terminal.clear()?;
+    app.fps.cap = options.fps.max(1) as f32;
     let mut pacer = Pacer::new(options.paced, options.max_rate);
     let mut parser = Parser::default();
     let result = main_loop(
@@ -329,7 +333,6 @@ fn main_loop(
     let period = Duration::from_secs_f64(1.0 / f64::from(fps));
     let mut last = Instant::now();
     let mut next_frame = last;
-    let mut last_frame = last;
     let mut dirty = true;
     // Resumed from our own suspension, before its SIGCONT arrived.
     let mut resumed = false;
@@ -340,8 +343,6 @@ fn main_loop(
         if wanted && now >= next_frame && pacer.may_send(now) {
             app.tick(now - last);
             last = now;
-            let frame_time = now - last_frame;
-            last_frame = now;
             app.link = LinkStatus {
                 bytes_per_second: pacer.bytes_per_second(now),
                 rtt: pacer.rtt,
@@ -350,9 +351,7 @@ fn main_loop(
                 budget: pacer.budget(now),
             };
             draw(app, terminal, pacer, bytes)?;
-            if !app.paused && frame_time > Duration::ZERO {
-                app.fps = 0.8 * app.fps + 0.2 / frame_time.as_secs_f32();
-            }
+            app.frame_drawn(now);
             next_frame = now + period;
             dirty = false;
             continue;

@@ -31,7 +31,7 @@ pub fn run(args: &LinkArgs, out: &mut impl Write) -> Result<(), super::CliError>
     let exe = std::env::current_exe()?;
     writeln!(
         out,
-        "link at 200×60 cells, 2 MB buffer; key `i`, time until the emulated screen shows it"
+        "link at 200×60 cells, 2 MB buffer; key `b` (culling), time until the emulated status line shows it"
     )?;
     writeln!(
         out,

@@ -8,7 +8,7 @@ use std::time::Instant;
 use glam::{Mat4, Vec3};
 
 use super::shaders::Lambert;
-use super::wire::{Mode, draw_wireframe, unique_edges};
+use super::wire::{Mode, WireCount, draw_wireframe, unique_edges};
 use super::{ColorTarget, DrawOptions, Renderer, VertexCache, transform};
 use crate::camera::Camera;
 use crate::mesh::Mesh;
@@ -114,7 +114,7 @@ impl StandardFrame {
     }
 
     /// Clears and draws one frame in `mode`. The mesh must have normals. Returns the
-    /// number of wireframe pixels written.
+    /// wireframe lines and pixels drawn.
     pub fn draw<C: ColorTarget>(
         &mut self,
         model: &Model,
@@ -123,7 +123,7 @@ impl StandardFrame {
         opts: &DrawOptions,
         mode: Mode,
         color: &mut C,
-    ) -> u64 {
+    ) -> WireCount {
         let mesh = &model.mesh;
         let shader = Self::shader(mesh, view, target);
         let start = Instant::now();
@@ -138,7 +138,7 @@ impl StandardFrame {
             let depth = mode.fills().then_some(&self.renderer.depth);
             draw_wireframe(&self.cache, &model.edges, target, depth, WIRE_COLOR, color)
         } else {
-            0
+            WireCount::default()
         };
         self.timing = [transformed - start, transformed.elapsed()];
         wire

@@ -119,8 +119,23 @@ pub fn project_edge<V>(
     Some(ScreenLine { line, z })
 }
 
+/// What a wireframe drew.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WireCount {
+    /// Lines with at least one pixel written.
+    pub lines: u64,
+    pub pixels: u64,
+}
+
+impl std::ops::AddAssign for WireCount {
+    fn add_assign(&mut self, o: Self) {
+        self.lines += o.lines;
+        self.pixels += o.pixels;
+    }
+}
+
 /// Draws the edges into `color`. With `depth`, only pixels passing the hidden-line
-/// test are drawn. Returns the number of pixels written.
+/// test are drawn.
 pub fn draw_wireframe<V, C: ColorTarget>(
     cache: &VertexCache<V>,
     edges: &[[u32; 2]],
@@ -128,10 +143,12 @@ pub fn draw_wireframe<V, C: ColorTarget>(
     depth: Option<&DepthBuffer>,
     wire: Vec3,
     color: &mut C,
-) -> u64 {
+) -> WireCount {
     let (w, h) = (i64::from(target.width), i64::from(target.height));
-    let mut written = 0;
+    let mut count = WireCount::default();
     for &e in edges {
+        let before = count.pixels;
+        let written = &mut count.pixels;
         let Some(sl) = project_edge(cache, e, target) else {
             continue;
         };
@@ -144,14 +161,15 @@ pub fn draw_wireframe<V, C: ColorTarget>(
                 let visible = depth.is_none_or(|d| sl.depth_at(k) - WIRE_DEPTH_BIAS <= d.at(i));
                 if visible {
                     color.put(i, wire);
-                    written += 1;
+                    *written += 1;
                 }
                 k += 1;
             },
             &mut NoTrace,
         );
+        count.lines += u64::from(count.pixels > before);
     }
-    written
+    count
 }
 
 /// What the probe knows about a line through a pixel.
@@ -218,4 +236,51 @@ impl Tracer for StepAt<'_> {
             self.out.push(s);
         }
     }
+}
+
+/// The line under pixel `(x, y)`, as the line panel shows it: a visible wireframe
+/// line through the pixel when `wires` gives the drawn edges (and the depth they were
+/// tested against), else the edge of `triangle` (the triangle covering the pixel)
+/// nearest to the pixel's centre. Returns the mesh edge, its screen line and the
+/// walk's step at (or nearest to) the pixel.
+#[must_use]
+pub fn line_under<V>(
+    cache: &VertexCache<V>,
+    indices: &[u32],
+    wires: Option<(&[[u32; 2]], Option<&DepthBuffer>)>,
+    triangle: Option<u32>,
+    target: Target,
+    x: u32,
+    y: u32,
+) -> Option<([u32; 2], ScreenLine, i64)> {
+    if let Some((edges, depth)) = wires {
+        let hits = probe_lines(cache, edges, target, depth, x, y);
+        if let Some(h) = hits.iter().find(|h| h.visible) {
+            return Some((h.edge, h.screen, h.step.k));
+        }
+    }
+    let t = triangle? as usize;
+    let tri = indices.get(t * 3..t * 3 + 3)?;
+    let (px, py) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
+    [[tri[0], tri[1]], [tri[1], tri[2]], [tri[2], tri[0]]]
+        .into_iter()
+        .filter_map(|e| {
+            let e = [e[0].min(e[1]), e[0].max(e[1])];
+            let sl = project_edge(cache, e, target)?;
+            let (a, b) = (sl.line.a, sl.line.b);
+            let (dx, dy) = ((b.0 - a.0) as f64, (b.1 - a.1) as f64);
+            let len = dx.hypot(dy).max(1e-9);
+            let dist = ((px - a.0 as f64 - 0.5) * dy - (py - a.1 as f64 - 0.5) * dx).abs() / len;
+            Some((dist, e, sl))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, e, sl)| {
+            let (sx, sy) = sl.line.start();
+            let k = if sl.line.swap_xy {
+                i64::from(y) - sy
+            } else {
+                i64::from(x) - sx
+            };
+            (e, sl, k.clamp(0, sl.line.dx))
+        })
 }

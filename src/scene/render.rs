@@ -19,7 +19,9 @@ use crate::raster::Target;
 use crate::raster::depth::{DepthBuffer, DepthState};
 use crate::raster::probe::{Probe, probe_from};
 use crate::render::standard::WIRE_COLOR;
-use crate::render::wire::{WIRE_DEPTH_BIAS, draw_wireframe};
+use crate::render::wire::{
+    ScreenLine, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under, project_edge,
+};
 use crate::render::{
     Cull, DrawOptions, DrawStats, Renderer, Rgba8, Shader, VertexCache, transform,
 };
@@ -261,14 +263,14 @@ pub trait ObjectPipeline {
         r: &mut Renderer,
         color: &mut Rgba8,
     );
-    /// Draws the object's edges; returns pixels written.
+    /// Draws the object's edges.
     fn wireframe(
         &self,
         obj: &SceneObject,
         target: Target,
         depth: Option<&DepthBuffer>,
         color: &mut Rgba8,
-    ) -> u64;
+    ) -> WireCount;
     /// Appends the object's silhouette edges, in the coordinates of `target`.
     fn silhouettes(
         &self,
@@ -289,6 +291,18 @@ pub trait ObjectPipeline {
     ) -> Probe<()>;
     /// The varying set this pipeline was compiled for.
     fn varyings(&self) -> VaryingSet;
+    /// The line under a pixel (see [`line_under`]), from this frame's vertices.
+    fn line_under(
+        &self,
+        obj: &SceneObject,
+        wires: Option<Option<&DepthBuffer>>,
+        triangle: Option<u32>,
+        target: Target,
+        x: u32,
+        y: u32,
+    ) -> Option<([u32; 2], ScreenLine, i64)>;
+    /// One of the object's edges projected to `target`, from this frame's vertices.
+    fn project_edge(&self, edge: [u32; 2], target: Target) -> Option<ScreenLine>;
 }
 
 /// The draw options an object's plan asks for.
@@ -337,7 +351,7 @@ impl<const K: usize> ObjectPipeline for Pipeline<K> {
         target: Target,
         depth: Option<&DepthBuffer>,
         color: &mut Rgba8,
-    ) -> u64 {
+    ) -> WireCount {
         counters::add(Stage::WireEdges, obj.edges.len() as u64);
         draw_wireframe(&self.cache, &obj.edges, target, depth, WIRE_COLOR, color)
     }
@@ -442,6 +456,31 @@ impl<const K: usize> ObjectPipeline for Pipeline<K> {
     fn varyings(&self) -> VaryingSet {
         self.varyings
     }
+
+    fn line_under(
+        &self,
+        obj: &SceneObject,
+        wires: Option<Option<&DepthBuffer>>,
+        triangle: Option<u32>,
+        target: Target,
+        x: u32,
+        y: u32,
+    ) -> Option<([u32; 2], ScreenLine, i64)> {
+        let wires = wires.map(|d| (obj.edges.as_slice(), d));
+        line_under(
+            &self.cache,
+            &obj.mesh.indices,
+            wires,
+            triangle,
+            target,
+            x,
+            y,
+        )
+    }
+
+    fn project_edge(&self, edge: [u32; 2], target: Target) -> Option<ScreenLine> {
+        project_edge(&self.cache, edge, target)
+    }
 }
 
 /// The pipeline for a varying set: the narrowest of [`PACKED_WIDTHS`] that holds it.
@@ -498,7 +537,7 @@ pub struct SceneFrame {
     pub silhouettes: Vec<Silhouette>,
     /// Counters of the last frame, all objects.
     pub stats: DrawStats,
-    pub wire_pixels: u64,
+    pub wire: WireCount,
 }
 
 impl std::fmt::Debug for SceneFrame {
@@ -525,7 +564,7 @@ impl SceneFrame {
                 .collect(),
             silhouettes: Vec::new(),
             stats: DrawStats::default(),
-            wire_pixels: 0,
+            wire: WireCount::default(),
         }
     }
 
@@ -598,11 +637,11 @@ impl SceneFrame {
             stats += self.renderer.stats;
             self.renderer.stats = DrawStats::default();
         }
-        self.wire_pixels = 0;
+        self.wire = WireCount::default();
         for ((obj, op), pipe) in scene.objects.iter().zip(&plan.objects).zip(&self.pipelines) {
             if op.wireframe {
                 let depth = op.hidden_lines.then_some(&self.renderer.depth);
-                self.wire_pixels += pipe.wireframe(obj, fine, depth, color);
+                self.wire += pipe.wireframe(obj, fine, depth, color);
             }
         }
         self.silhouettes.clear();
@@ -642,6 +681,51 @@ impl SceneFrame {
             out.push(p);
         }
         out
+    }
+
+    /// The line under pixel `(x, y)` of the frame's (supersampled) target: of the
+    /// object seen there, a drawn wireframe line through the pixel or the nearest edge
+    /// of its triangle. Returns the object's index, the edge, its screen line and step.
+    #[must_use]
+    pub fn line_under(
+        &self,
+        scene: &Scene,
+        x: u32,
+        y: u32,
+    ) -> Option<(usize, [u32; 2], ScreenLine, i64)> {
+        let probes = self.probe(scene, x, y);
+        let seen = probes.iter().rposition(|p| p.winner.is_some());
+        let depth = self.renderer.has_depth().then_some(&self.renderer.depth);
+        // The object seen there first; else any drawn wireframe through the pixel.
+        let order = seen.into_iter().chain(
+            (0..scene.objects.len())
+                .filter(|&i| Some(i) != seen && scene.plan.objects[i].wireframe),
+        );
+        for i in order {
+            let op = &scene.plan.objects[i];
+            let triangle = probes[i].winner.map(|w| probes[i].records[w].triangle);
+            let wires = op.wireframe.then(|| depth.filter(|_| op.hidden_lines));
+            let found = self.pipelines[i].line_under(
+                &scene.objects[i],
+                wires,
+                triangle,
+                self.renderer.target,
+                x,
+                y,
+            );
+            if let Some((e, sl, k)) = found {
+                return Some((i, e, sl, k));
+            }
+        }
+        None
+    }
+
+    /// Edge `edge` of object `object` projected to the frame's (supersampled) target.
+    #[must_use]
+    pub fn project_edge(&self, object: usize, edge: [u32; 2]) -> Option<ScreenLine> {
+        self.pipelines
+            .get(object)?
+            .project_edge(edge, self.renderer.target)
     }
 }
 

@@ -2,20 +2,18 @@
 //! the seed notes' names (F01, F02, F03, u, v, w, depth, octant, dx, dy, incrE,
 //! incrNE, d).
 
-use std::fmt::Write as _;
-
 use crate::accuracy::area::grid_side;
 use crate::raster::line::Move;
 use crate::raster::probe::{DepthOutcome, Probe, probe};
 use crate::render::Shader;
 use crate::render::standard::{Model, StandardFrame};
 use crate::render::target::luminance;
-use crate::render::wire::{ScreenLine, probe_lines, project_edge};
+use crate::render::wire::{ScreenLine, line_under, project_edge};
 use crate::terminal::GlyphMode;
 use crate::terminal::glyphs::{Sample, explain};
 
-use super::app::SceneState;
-use super::viewport::Viewport;
+use super::panel::PanelText;
+use super::viewport::{SceneState, Viewport};
 
 /// The sample pixel of sub-sample `sub` of cell `(cx, cy)`.
 #[must_use]
@@ -37,18 +35,20 @@ fn cell_header(
     vp: &Viewport,
     cx: u16,
     cy: u16,
-) -> Option<(String, [Sample; GlyphMode::MAX_SAMPLES], usize)> {
+) -> Option<(PanelText, [Sample; GlyphMode::MAX_SAMPLES], usize)> {
     let g = vp.cell(cx, cy)?;
     let (samples, n) = vp.samples(cx, cy);
-    let mut t = String::new();
-    let _ = writeln!(
-        t,
-        "cell ({cx},{cy})  glyph '{}'  fg {}  bg {}",
-        g.ch,
-        hex(g.fg),
-        hex(g.bg)
+    let mut t = PanelText::default();
+    t.fields(
+        0,
+        [
+            format!("cell ({cx},{cy})"),
+            format!("glyph '{}'", g.ch),
+            format!("fg {}", hex(g.fg)),
+            format!("bg {}", hex(g.bg)),
+        ],
     );
-    let _ = writeln!(t, "  {}", explain(vp.settings.glyphs, &samples[..n], g));
+    t.prose(2, &explain(vp.settings.glyphs, &samples[..n], g));
     Some((t, samples, n))
 }
 
@@ -65,9 +65,11 @@ fn listed(vp: &Viewport, n: usize, sub: usize) -> std::ops::Range<usize> {
 
 /// The inspector text for cell `(cx, cy)`, detailing sub-sample `sub`.
 #[must_use]
-pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize) -> String {
+pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize) -> PanelText {
     let Some((mut t, _, n)) = cell_header(vp, cx, cy) else {
-        return "cursor outside the view".into();
+        let mut t = PanelText::default();
+        t.prose(0, "cursor outside the view");
+        return t;
     };
     let opts = vp.settings.options();
     let indices = &model.mesh.indices;
@@ -75,14 +77,15 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
     let shader = StandardFrame::shader(&model.mesh, &view, vp.target);
     let rows = listed(vp, n, sub);
     if rows.len() < n {
-        let _ = writeln!(
-            t,
-            "samples {}–{} of {n} (Tab moves):",
-            rows.start,
-            rows.end - 1
+        t.fields(
+            0,
+            [
+                format!("samples {}–{} of {n}", rows.start, rows.end - 1),
+                "(Tab moves):".into(),
+            ],
         );
     } else {
-        let _ = writeln!(t, "samples ({n} per cell):");
+        t.fields(0, [format!("samples ({n} per cell):")]);
     }
     // The selected sample's probe is kept for the overdraw list below.
     let mut selected = None;
@@ -90,24 +93,37 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
         let (x, y) = sample_pixel(vp, cx, cy, k);
         let p = probe(&vp.frame.cache, indices, vp.target, &opts, x, y);
         let mark = if k == sub % n { '>' } else { ' ' };
+        let touched = format!("({} touched)", p.records.len());
         match p.winner.map(|w| &p.records[w]) {
             Some(r) => {
                 let shade = luminance(shader.fragment(&r.varying));
-                let _ = writeln!(
-                    t,
-                    "{mark}s{k} ({x},{y}) covered by t{} depth {:.5} shade {shade:.3} ({} touched)",
-                    r.triangle,
-                    r.eval.depth,
-                    p.records.len()
+                let shade = format!("shade {shade:.3}");
+                t.fields_or(
+                    0,
+                    [
+                        format!("{mark}s{k} ({x},{y})"),
+                        format!("covered by t{}", r.triangle),
+                        format!("depth {:.5}", r.eval.depth),
+                        shade.clone(),
+                        touched,
+                    ],
+                    [
+                        format!("{mark}s{k} ({x},{y})"),
+                        format!("t{}", r.triangle),
+                        format!("z {:.5}", r.eval.depth),
+                        shade,
+                        format!("{} touched", p.records.len()),
+                    ],
                 );
             }
-            None => {
-                let _ = writeln!(
-                    t,
-                    "{mark}s{k} ({x},{y}) not covered ({} touched)",
-                    p.records.len()
-                );
-            }
+            None => t.fields(
+                0,
+                [
+                    format!("{mark}s{k} ({x},{y})"),
+                    "not covered".into(),
+                    touched,
+                ],
+            ),
         }
         if k == sub % n {
             selected = Some(p);
@@ -115,16 +131,22 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
     }
     let (x, y) = sample_pixel(vp, cx, cy, sub);
     let Some(p) = selected else { return t };
-    let _ = writeln!(t, "sample ({x},{y}), overdraw in draw order:");
+    t.fields(
+        0,
+        [
+            format!("sample ({x},{y})"),
+            "overdraw in draw order:".into(),
+        ],
+    );
     overdraw_text(&mut t, &p, opts.depth.uses_buffer());
     t
 }
 
 /// The overdraw list of a probe: every triangle whose box holds the pixel, in draw
 /// order, with its edge values, barycentrics, depth and depth test.
-fn overdraw_text<V>(t: &mut String, p: &Probe<V>, depth_test: bool) {
+fn overdraw_text<V>(t: &mut PanelText, p: &Probe<V>, depth_test: bool) {
     if p.records.is_empty() {
-        let _ = writeln!(t, "  no triangle's box holds this sample");
+        t.prose(2, "no triangle's box holds this sample");
     }
     for (i, r) in p.records.iter().enumerate() {
         let star = if p.winner == Some(i) { "*" } else { " " };
@@ -135,31 +157,47 @@ fn overdraw_text<V>(t: &mut String, p: &Probe<V>, depth_test: bool) {
             DepthOutcome::Passed { against } => format!("passed {:.5} < {:.5}", e.depth, against),
             DepthOutcome::Failed { against } => format!("failed {:.5} >= {:.5}", e.depth, against),
         };
-        let _ = writeln!(
-            t,
-            "{star}t{}{} block {}  {test}",
-            r.triangle,
-            if r.clipped {
-                format!(".{}", r.piece)
-            } else {
-                String::new()
-            },
-            r.block.name()
+        let piece = if r.clipped {
+            format!(".{}", r.piece)
+        } else {
+            String::new()
+        };
+        t.fields(
+            0,
+            [
+                format!("{star}t{}{piece}", r.triangle),
+                format!("block {}", r.block.name()),
+                test,
+            ],
         );
-        let _ = writeln!(
-            t,
-            "   F01 {} F02 {} F03 {}  area2 {}",
-            e.f[0] + r.setup.bias[0],
-            e.f[1] + r.setup.bias[1],
-            e.f[2] + r.setup.bias[2],
-            r.setup.area2
+        t.fields(
+            3,
+            [
+                format!("F01 {}", e.f[0] + r.setup.bias[0]),
+                format!("F02 {}", e.f[1] + r.setup.bias[1]),
+                format!("F03 {}", e.f[2] + r.setup.bias[2]),
+                format!("area2 {}", r.setup.area2),
+            ],
         );
-        let _ = writeln!(
-            t,
-            "   u {:.4} v {:.4} w {:.4}  persp {:.4} {:.4} {:.4}",
-            e.bary[0], e.bary[1], e.bary[2], e.persp[0], e.persp[1], e.persp[2]
+        t.fields(
+            3,
+            [
+                format!("u {:.4}", e.bary[0]),
+                format!("v {:.4}", e.bary[1]),
+                format!("w {:.4}", e.bary[2]),
+                format!(
+                    "persp {:.4} {:.4} {:.4}",
+                    e.persp[0], e.persp[1], e.persp[2]
+                ),
+            ],
         );
-        let _ = writeln!(t, "   1/w {:.5}  depth {:.6}", e.inv_w, e.depth);
+        t.fields(
+            3,
+            [
+                format!("1/w {:.5}", e.inv_w),
+                format!("depth {:.6}", e.depth),
+            ],
+        );
     }
 }
 
@@ -167,28 +205,41 @@ fn overdraw_text<V>(t: &mut String, p: &Probe<V>, depth_test: bool) {
 /// selected sample each object's overdraw list in draw order (depth carried from
 /// object to object), with the object's pipeline.
 #[must_use]
-pub fn scene_inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub: usize) -> String {
+pub fn scene_inspector_text(
+    vp: &Viewport,
+    s: &SceneState,
+    cx: u16,
+    cy: u16,
+    sub: usize,
+) -> PanelText {
     let Some((mut t, samples, n)) = cell_header(vp, cx, cy) else {
-        return "cursor outside the view".into();
+        let mut t = PanelText::default();
+        t.prose(0, "cursor outside the view");
+        return t;
     };
     for k in listed(vp, n, sub) {
         let smp = samples[k];
         let mark = if k == sub % n { '>' } else { ' ' };
         let (x, y) = sample_pixel(vp, cx, cy, k);
-        let _ = writeln!(
-            t,
-            "{mark}s{k} ({x},{y}) {} {}",
-            if smp.covered { "covered" } else { "empty" },
-            hex(Some(smp.rgb))
+        t.fields(
+            0,
+            [
+                format!("{mark}s{k} ({x},{y})"),
+                (if smp.covered { "covered" } else { "empty" }).to_string(),
+                hex(Some(smp.rgb)),
+            ],
         );
     }
-    let (x, y) = sample_pixel(vp, cx, cy, sub);
+    let (fx, fy) = scene_pixel(vp, s, cx, cy, sub);
     let side = grid_side(s.scene.plan.samples);
-    let (fx, fy) = (x * side + side / 2, y * side + side / 2);
     if side > 1 {
-        let _ = writeln!(
-            t,
-            "supersampled: probing sample ({fx},{fy}) of its {side}×{side} grid"
+        t.fields(
+            0,
+            [
+                "supersampled:".to_string(),
+                format!("probing sample ({fx},{fy})"),
+                format!("of its {side}×{side} grid"),
+            ],
         );
     }
     for ((p, obj), op) in s
@@ -198,95 +249,156 @@ pub fn scene_inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub
         .zip(&s.scene.objects)
         .zip(&s.scene.plan.objects)
     {
-        let _ = writeln!(
-            t,
-            "object {} ({}), varyings {}:",
-            obj.desc.name,
-            if op.depth_test {
-                "depth test"
-            } else {
-                "no depth test"
-            },
-            op.varyings
+        t.fields(
+            0,
+            [
+                format!("object {}", obj.desc.name),
+                format!(
+                    "({})",
+                    if op.depth_test {
+                        "depth test"
+                    } else {
+                        "no depth test"
+                    }
+                ),
+                format!("varyings {}:", op.varyings),
+            ],
         );
         overdraw_text(&mut t, p, op.depth_test);
     }
-    let _ = writeln!(
-        t,
-        "(the line panel traces models only; scene wireframes are drawn, not traced)"
-    );
     t
 }
 
-/// The line under a sample: a visible wireframe line through it, else the edge of the
-/// covering triangle nearest to it. Returns the mesh edge, its screen line and step.
+/// The pixel of the scene's (possibly supersampled) frame that stands for sub-sample
+/// `sub` of cell `(cx, cy)`: the middle of its grid.
 #[must_use]
-pub fn line_at(
+pub fn scene_pixel(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub: usize) -> (u32, u32) {
+    let (x, y) = sample_pixel(vp, cx, cy, sub);
+    let side = grid_side(s.scene.plan.samples);
+    (x * side + side / 2, y * side + side / 2)
+}
+
+/// The line the line panel shows: a model's edge, or an edge of a scene's object, and
+/// the step along it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LineFocus {
+    /// The scene object, for scenes.
+    pub object: Option<usize>,
+    pub edge: [u32; 2],
+    pub k: i64,
+}
+
+/// The line under sub-sample `sub` of cell `(cx, cy)` (see [`line_under`]), with its
+/// screen line in the frame's pixel grid (a scene's supersampled one).
+#[must_use]
+pub fn line_at_sample(
     vp: &Viewport,
     model: &Model,
-    x: u32,
-    y: u32,
-) -> Option<([u32; 2], ScreenLine, i64)> {
-    let depth = vp.settings.mode.fills().then_some(&vp.frame.renderer.depth);
-    if vp.settings.mode.wires() {
-        let hits = probe_lines(&vp.frame.cache, &model.edges, vp.target, depth, x, y);
-        if let Some(h) = hits.iter().find(|h| h.visible) {
-            return Some((h.edge, h.screen, h.step.k));
-        }
+    scene: Option<&SceneState>,
+    (cx, cy, sub): (u16, u16, usize),
+) -> Option<(LineFocus, ScreenLine)> {
+    if let Some(s) = scene {
+        let (fx, fy) = scene_pixel(vp, s, cx, cy, sub);
+        let (object, edge, sl, k) = s.frame.line_under(&s.scene, fx, fy)?;
+        return Some((
+            LineFocus {
+                object: Some(object),
+                edge,
+                k,
+            },
+            sl,
+        ));
     }
+    let (x, y) = sample_pixel(vp, cx, cy, sub);
+    let depth = vp.settings.mode.fills().then_some(&vp.frame.renderer.depth);
+    let wires = vp
+        .settings
+        .mode
+        .wires()
+        .then_some((model.edges.as_slice(), depth));
     let opts = vp.settings.options();
     let p = probe(&vp.frame.cache, &model.mesh.indices, vp.target, &opts, x, y);
-    let t = p.records[p.winner?].triangle as usize;
-    let tri = &model.mesh.indices[t * 3..t * 3 + 3];
-    let (px, py) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
-    [[tri[0], tri[1]], [tri[1], tri[2]], [tri[2], tri[0]]]
-        .into_iter()
-        .filter_map(|e| {
-            let sl = project_edge(&vp.frame.cache, [e[0].min(e[1]), e[0].max(e[1])], vp.target)?;
-            let (a, b) = (sl.line.a, sl.line.b);
-            let (dx, dy) = ((b.0 - a.0) as f64, (b.1 - a.1) as f64);
-            let len = dx.hypot(dy).max(1e-9);
-            let dist = ((px - a.0 as f64 - 0.5) * dy - (py - a.1 as f64 - 0.5) * dx).abs() / len;
-            Some((dist, [e[0].min(e[1]), e[0].max(e[1])], sl))
-        })
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .map(|(_, e, sl)| {
-            let (sx, sy) = sl.line.start();
-            let k = if sl.line.swap_xy {
-                i64::from(y) - sy
-            } else {
-                i64::from(x) - sx
-            };
-            (e, sl, k.clamp(0, sl.line.dx))
-        })
+    let triangle = p.winner.map(|w| p.records[w].triangle);
+    let (edge, sl, k) = line_under(
+        &vp.frame.cache,
+        &model.mesh.indices,
+        wires,
+        triangle,
+        vp.target,
+        x,
+        y,
+    )?;
+    Some((
+        LineFocus {
+            object: None,
+            edge,
+            k,
+        },
+        sl,
+    ))
+}
+
+/// The screen line of a focus, this frame.
+#[must_use]
+pub fn project_focus(
+    vp: &Viewport,
+    scene: Option<&SceneState>,
+    f: LineFocus,
+) -> Option<ScreenLine> {
+    match (scene, f.object) {
+        (Some(s), Some(o)) => s.frame.project_edge(o, f.edge),
+        _ => project_edge(&vp.frame.cache, f.edge, vp.target),
+    }
 }
 
 /// The line panel for a line and a step on it.
 #[must_use]
-pub fn line_text(edge: [u32; 2], sl: &ScreenLine, k: i64) -> String {
+pub fn line_text(f: LineFocus, sl: &ScreenLine) -> PanelText {
     let l = &sl.line;
-    let mut t = String::new();
-    let _ = writeln!(
-        t,
-        "edge v{}-v{}: ({},{}) -> ({},{})",
-        edge[0], edge[1], l.a.0, l.a.1, l.b.0, l.b.1
+    let k = f.k;
+    let mut t = PanelText::default();
+    let object = f.object.map_or(String::new(), |o| format!("object {o} "));
+    t.fields(
+        0,
+        [
+            format!("{object}edge v{}-v{}:", f.edge[0], f.edge[1]),
+            format!("({},{}) -> ({},{})", l.a.0, l.a.1, l.b.0, l.b.1),
+        ],
     );
-    let _ = writeln!(t, "octant {}  reflections: {}", l.octant, l.reflections());
-    let _ = writeln!(
-        t,
-        "dx {}  dy {}  incrE {}  incrNE {}",
-        l.dx, l.dy, l.incr_e, l.incr_ne
+    t.fields(
+        0,
+        [
+            format!("octant {}", l.octant),
+            format!("reflections: {}", l.reflections()),
+        ],
+    );
+    t.fields(
+        0,
+        [
+            format!("dx {}", l.dx),
+            format!("dy {}", l.dy),
+            format!("incrE {}", l.incr_e),
+            format!("incrNE {}", l.incr_ne),
+        ],
     );
     let (x, y) = l.pixel(k, l.minor_at(k));
     let d = l.d_at(k);
-    let _ = write!(t, "step {k}/{}  pixel ({x},{y})  d {d}", l.dx);
-    if k < l.dx {
+    let decision = if k < l.dx {
         let mv = if d <= 0 { Move::E } else { Move::NE };
         let after = d + if mv == Move::E { l.incr_e } else { l.incr_ne };
-        let _ = writeln!(t, " -> {} ({}), d' {after}", mv.name(), l.direction(mv));
+        format!("-> {} ({}), d' {after}", mv.name(), l.direction(mv))
     } else {
-        let _ = writeln!(t, " (last pixel)");
-    }
-    let _ = writeln!(t, "line depth {:.5}", sl.depth_at(k));
+        "(last pixel)".into()
+    };
+    t.fields(
+        0,
+        [
+            format!("step {k}/{}", l.dx),
+            format!("pixel ({x},{y})"),
+            format!("d {d}"),
+            decision,
+        ],
+    );
+    t.fields(0, [format!("line depth {:.5}", sl.depth_at(k))]);
     t
 }

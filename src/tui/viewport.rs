@@ -10,7 +10,7 @@ use ratatui::widgets::Widget;
 
 use crate::raster::Target;
 use crate::render::standard::{Model, StandardFrame, StandardView};
-use crate::render::wire::Mode;
+use crate::render::wire::{Mode, WireCount};
 use crate::render::{Cull, DrawOptions, Rgba8};
 use crate::scene::Scene;
 use crate::scene::render::{SceneFrame, SceneView};
@@ -75,6 +75,15 @@ impl ViewSettings {
 
 /// Buffers and results of the last rendered frame. Everything is reused; buffers are
 /// resized only when the viewport or the glyph mode changes.
+/// A scene in the viewer: what it is, its pipelines and buffers, and its time.
+#[derive(Debug)]
+pub struct SceneState {
+    pub scene: Scene,
+    pub frame: SceneFrame,
+    /// Seconds of animation (stops while paused).
+    pub time: f32,
+}
+
 #[derive(Debug)]
 pub struct Viewport {
     pub frame: StandardFrame,
@@ -89,7 +98,8 @@ pub struct Viewport {
     pub view: StandardView,
     /// Time spent fitting glyphs.
     pub glyph_time: Duration,
-    pub wire_pixels: u64,
+    /// What the wireframe drew.
+    pub wire: WireCount,
 }
 
 impl Default for Viewport {
@@ -104,7 +114,7 @@ impl Default for Viewport {
             settings: ViewSettings::default(),
             view: StandardView::at(0.0),
             glyph_time: Duration::ZERO,
-            wire_pixels: 0,
+            wire: WireCount::default(),
         }
     }
 }
@@ -114,7 +124,7 @@ impl Viewport {
     pub fn render(&mut self, model: &Model, settings: &ViewSettings, cols: u16, rows: u16) {
         let target = self.lay_out(settings, cols, rows);
         self.view = settings.view(model);
-        self.wire_pixels = self.frame.draw(
+        self.wire = self.frame.draw(
             model,
             &self.view,
             target,
@@ -148,7 +158,7 @@ impl Viewport {
         let start = Instant::now();
         frame.draw(scene, target, &view);
         self.frame.timing = [Duration::ZERO, start.elapsed()];
-        self.wire_pixels = frame.wire_pixels;
+        self.wire = frame.wire;
         // The finished frame becomes the viewport's; its old buffer is drawn into next.
         std::mem::swap(&mut self.color, &mut frame.color);
         self.fit_cells();
@@ -279,6 +289,36 @@ impl Viewport {
             }
         }
         (sx * sy) as usize
+    }
+
+    /// Whether any sample of cell `(cx, cy)` is covered.
+    #[must_use]
+    pub fn covered(&self, cx: u16, cy: u16) -> bool {
+        let (samples, n) = self.samples(cx, cy);
+        samples[..n].iter().any(|s| s.covered)
+    }
+
+    /// The covered cell nearest the centre of the covered cells (the middle of the
+    /// model's projection), if any cell is covered.
+    #[must_use]
+    pub fn central_covered_cell(&self) -> Option<(u16, u16)> {
+        let cells = (0..self.rows)
+            .flat_map(|y| (0..self.cols).map(move |x| (x, y)))
+            .filter(|&(x, y)| self.covered(x, y));
+        let (mut n, mut sx, mut sy) = (0f64, 0f64, 0f64);
+        for (x, y) in cells.clone() {
+            n += 1.0;
+            sx += f64::from(x);
+            sy += f64::from(y);
+        }
+        let (mx, my) = (sx / n.max(1.0), sy / n.max(1.0));
+        // Cells are about twice as tall as wide: distance in cell widths.
+        cells.min_by(|a, b| {
+            let d = |c: &(u16, u16)| {
+                (f64::from(c.0) - mx).powi(2) + (2.0 * (f64::from(c.1) - my)).powi(2)
+            };
+            d(a).total_cmp(&d(b))
+        })
     }
 
     /// The glyph of a cell.

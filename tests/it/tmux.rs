@@ -17,6 +17,11 @@ impl Tmux {
 
     /// A session running `shell` (a job-control shell for Ctrl-Z).
     fn with_shell(tag: &str, shell: &str) -> Option<Self> {
+        Self::sized(tag, shell, 130, 40)
+    }
+
+    /// A session of `cols × rows` running `shell`.
+    fn sized(tag: &str, shell: &str, cols: u16, rows: u16) -> Option<Self> {
         Command::new("tmux")
             .arg("-V")
             .output()
@@ -33,9 +38,9 @@ impl Tmux {
                 "-s",
                 "t",
                 "-x",
-                "130",
+                &cols.to_string(),
                 "-y",
-                "40",
+                &rows.to_string(),
                 shell,
             ])
             .is_some();
@@ -147,6 +152,32 @@ impl Drop for Tmux {
     }
 }
 
+/// The status line (the screen's last non-empty row).
+fn status(screen: &str) -> &str {
+    screen
+        .lines()
+        .rfind(|l| !l.trim().is_empty())
+        .unwrap_or_default()
+}
+
+/// The selected cell, from the inspector's first line (`cell (x,y)`).
+fn selected_cell(screen: &str) -> Option<(i32, i32)> {
+    let at = screen.find("cell (")? + "cell (".len();
+    let rest = &screen[at..];
+    let (x, rest) = rest.split_once(',')?;
+    let (y, _) = rest.split_once(')')?;
+    Some((x.trim().parse().ok()?, y.trim().parse().ok()?))
+}
+
+/// The model's part of the screen: every row, cut before column `cols`.
+fn model_rows(screen: &str, cols: usize) -> String {
+    screen
+        .lines()
+        .map(|l| l.chars().take(cols).collect::<String>())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 #[test]
 fn inspect_pause_quit_and_restore() {
     let Some(t) = Tmux::new("keys") else {
@@ -159,18 +190,145 @@ fn inspect_pause_quit_and_restore() {
         "1 1 0",
         "viewer runs on the alternate screen with the mouse on"
     );
-    t.keys(&["i", " "]);
-    for _ in 0..30 {
-        t.keys(&["Right"]);
-    }
-    t.keys(&["Down", "Down"]);
+    t.keys(&["i"]);
     let s = t.wait_for("inspector");
-    for field in ["inspector", "paused", "samples", "line"] {
+    for field in ["inspector", "samples", "line", "paused", "click or arrows"] {
         assert!(s.contains(field), "missing {field}:\n{s}");
     }
+    // The cursor lands on the model: its selected sample is covered.
+    let selected = s.lines().find(|l| l.contains("│>s")).unwrap_or_default();
+    assert!(
+        !selected.is_empty() && !selected.contains("not covered"),
+        "the cursor is not on the model:\n{s}"
+    );
+    // Frozen: the model stays still while the numbers are read.
+    let view_cols = 130 - 58;
+    let a = model_rows(&t.screen(), view_cols);
+    sleep(Duration::from_millis(400));
+    assert_eq!(
+        a,
+        model_rows(&t.screen(), view_cols),
+        "the model moved in inspect mode"
+    );
+    // Shift+Right moves the cursor 8 cells, Right one.
+    let (x0, y0) = selected_cell(&t.screen()).expect("a selected cell");
+    t.keys(&["S-Right", "Right", "Down"]);
+    sleep(Duration::from_millis(300));
+    assert_eq!(selected_cell(&t.screen()), Some((x0 + 9, y0 + 1)));
+    // Space spins the model again, the inspector still open.
+    t.keys(&[" "]);
+    sleep(Duration::from_millis(400));
+    let s = t.screen();
+    assert!(
+        s.contains("inspector") && !status(&s).contains("paused"),
+        "{s}"
+    );
+    assert_ne!(
+        model_rows(&s, view_cols),
+        a,
+        "space did not resume the spin"
+    );
     t.keys(&["?"]);
     assert!(t.wait_for("keys").contains("quit"));
     t.keys(&["Escape", "q"]);
+    t.assert_restored();
+}
+
+/// The panel's lines at the usual sizes: every field on one row, never split.
+#[test]
+fn panel_fields_are_never_split() {
+    for (cols, rows) in [(140, 45), (200, 60)] {
+        let Some(t) = Tmux::sized("panel", "sh", cols, rows) else {
+            eprintln!("tmux not installed: skipping the terminal end-to-end test");
+            return;
+        };
+        t.start_viewer();
+        t.keys(&["i"]);
+        let s = t.wait_for("overdraw");
+        // Each label has its values beside it, on the same row.
+        for (label, values) in [
+            ("area2", 1),
+            ("persp", 3),
+            ("F01", 1),
+            ("1/w", 1),
+            ("incrNE", 1),
+        ] {
+            assert!(
+                s.lines().any(|l| numbers_after(l, label) >= values),
+                "{cols}x{rows}: `{label}` without its {values} value(s) on its row:\n{s}"
+            );
+        }
+        assert!(
+            s.lines()
+                .any(|l| l.contains("touched") && l.contains("│>s")),
+            "{cols}x{rows}: the touched count left its sample's row:\n{s}"
+        );
+        // No row of the panel ends inside a number or a label.
+        for l in s.lines().filter(|l| l.contains('│')) {
+            let inner = l.rsplit('│').nth(1).unwrap_or_default();
+            assert!(
+                !inner.trim_end().ends_with(['(', '-']),
+                "{cols}x{rows}: a row ends mid-field: {inner:?}"
+            );
+        }
+        t.keys(&["q"]);
+    }
+}
+
+/// How many numbers follow `label` on `line` (the panel's border excluded).
+fn numbers_after(line: &str, label: &str) -> usize {
+    let Some(at) = line.find(&format!("{label} ")) else {
+        return 0;
+    };
+    line[at + label.len()..]
+        .split_whitespace()
+        .take_while(|w| w.trim_end_matches('│').parse::<f64>().is_ok())
+        .count()
+}
+
+/// At 80×24 the side panel does not fit: the inspector goes below the model.
+#[test]
+fn the_inspector_works_at_80x24() {
+    let Some(t) = Tmux::sized("small", "sh", 80, 24) else {
+        eprintln!("tmux not installed: skipping the terminal end-to-end test");
+        return;
+    };
+    t.start_viewer();
+    assert!(status(&t.screen()).contains("? help"), "{}", t.screen());
+    t.keys(&["i"]);
+    let s = t.wait_for("inspector");
+    assert!(s.contains("inspector") && s.contains("cell ("), "{s}");
+    // The panel is below the model: its title row starts at the left edge.
+    let title = s
+        .lines()
+        .find(|l| l.contains("inspector"))
+        .unwrap_or_default();
+    assert!(title.starts_with('┌'), "not below the model:\n{s}");
+    assert!(status(&s).contains("? help"), "status lost `? help`:\n{s}");
+    t.keys(&["Escape", "q"]);
+    t.assert_restored();
+}
+
+/// The frame rate shown never exceeds the cap.
+#[test]
+fn fps_never_exceeds_the_cap() {
+    let Some(t) = Tmux::new("fps") else {
+        eprintln!("tmux not installed: skipping the terminal end-to-end test");
+        return;
+    };
+    t.start_viewer_with("TERM=xterm-256color LANG=C.UTF-8", "--fps 12");
+    for _ in 0..8 {
+        let s = t.screen();
+        let line = status(&s);
+        let fps: Option<f32> = line
+            .split(" | ")
+            .find_map(|f| f.strip_suffix(" fps").and_then(|n| n.trim().parse().ok()));
+        if let Some(fps) = fps {
+            assert!(fps <= 12.0, "{fps} fps above the cap: {line}");
+        }
+        sleep(Duration::from_millis(150));
+    }
+    t.keys(&["q"]);
     t.assert_restored();
 }
 

@@ -11,23 +11,27 @@
 //! | anti-aliasing ([`area`]) | `1x`, `4x`, `16x` samples per pixel | exact area of triangle ∩ pixel |
 //! | depth ([`depth`]) | `depth-f32`, `depth-unorm24`, `depth-unorm16`, `depth-f32-reversed` | the known nearer of two close planes |
 //!
-//! Times are the median of repeated runs of a whole workload; errors come from one
-//! more run recorded in full. [`cases`] holds the hard cases the stability suite and
-//! the table share.
+//! Times are the median of rounds of a whole workload, with the 95 % interval of that
+//! median ([`timing`]): the variants of a family on a workload are timed in
+//! interleaved rounds until each interval is narrow enough or its time budget is
+//! spent. Errors come from one more run recorded in full. [`cases`] holds the hard
+//! cases the stability suite and the table share.
 
 pub mod area;
 pub mod cases;
 pub mod depth;
 pub mod edge;
+pub mod timing;
 pub mod workloads;
 
-use std::time::Instant;
+use std::time::Duration;
 
 use glam::{Mat4, Vec2, Vec3};
 
 use self::area::{SAMPLE_COUNTS, Supersampled, aa_name, pixel_areas, snapped, supersample};
 use self::depth::{DepthFormat, DepthPass};
 use self::edge::EdgeArith;
+use self::timing::{Policy, Timing, measure_each};
 use self::workloads::{Scene3, UvShader, WORKLOADS};
 use crate::raster::interp::Interpolation;
 use crate::raster::{BitMask, CountGrid, CoverageSink, Setup, Target, Traversal};
@@ -76,6 +80,18 @@ impl Family {
             Family::Depth => "z-fighting rate",
         }
     }
+
+    /// The variant the others are timed against: what the renderer uses.
+    #[must_use]
+    pub fn baseline(self) -> &'static str {
+        match self {
+            Family::Edge => "fixed8",
+            Family::Traversal => "wide",
+            Family::Interpolation => "perspective",
+            Family::AntiAliasing => "1x",
+            Family::Depth => "depth-f32",
+        }
+    }
 }
 
 /// Which sizes and how much work.
@@ -84,8 +100,8 @@ pub struct Config {
     pub sizes: Vec<Target>,
     /// Scales the triangle counts of the tiny and sliver workloads.
     pub scale: f64,
-    /// Timed runs per measurement (the median is reported).
-    pub repeats: usize,
+    /// How long each measurement is timed (the median of its rounds is reported).
+    pub timing: Policy,
 }
 
 impl Config {
@@ -99,18 +115,18 @@ impl Config {
                 Target::new(1920, 1080),
             ],
             scale: 1.0,
-            repeats: 5,
+            timing: Policy::new(5, 0.02, Duration::from_millis(300)),
         }
     }
 
-    /// Terminal sizes only, thinner workloads, fewer repeats: every variant, in
-    /// seconds.
+    /// Terminal sizes only, thinner workloads, a smaller time budget per
+    /// measurement: every variant, in seconds.
     #[must_use]
     pub fn quick() -> Self {
         Self {
             sizes: vec![Target::new(80, 24), Target::new(200, 60)],
             scale: 0.5,
-            repeats: 5,
+            timing: Policy::new(5, 0.03, Duration::from_millis(30)),
         }
     }
 }
@@ -149,46 +165,29 @@ pub struct Row {
     pub triangles: u64,
     /// Pixels (fragments, samples resolved to pixels) produced per run.
     pub pixels: u64,
-    /// Median time of one run, nanoseconds.
-    pub median_ns: f64,
+    /// Time of one run in nanoseconds: the median of the rounds and its interval.
+    pub time: Timing,
     pub errors: Errors,
 }
 
 impl Row {
+    /// Median nanoseconds of one run.
+    #[must_use]
+    pub fn median_ns(&self) -> f64 {
+        self.time.median
+    }
+
     /// Nanoseconds per triangle.
     #[must_use]
     pub fn ns_per_triangle(&self) -> f64 {
-        self.median_ns / self.triangles.max(1) as f64
+        self.time.median / self.triangles.max(1) as f64
     }
 
     /// Million pixels per second.
     #[must_use]
     pub fn mpx_per_s(&self) -> f64 {
-        self.pixels as f64 / self.median_ns.max(1.0) * 1e3
+        self.pixels as f64 / self.time.median.max(1.0) * 1e3
     }
-}
-
-/// Shortest timed sample: runs shorter than this are repeated within one sample, so
-/// microsecond workloads (80×24) are not lost in timer and scheduler noise.
-const MIN_SAMPLE_NS: f64 = 2e6;
-
-/// Median wall time of one run of `f` over `repeats` samples, in nanoseconds.
-fn median_ns(repeats: usize, mut f: impl FnMut()) -> f64 {
-    let start = Instant::now();
-    f();
-    let once = start.elapsed().as_secs_f64() * 1e9;
-    let inner = (MIN_SAMPLE_NS / once.max(1.0)).ceil().clamp(1.0, 100_000.0) as usize;
-    let mut t: Vec<f64> = (0..repeats.max(1))
-        .map(|_| {
-            let start = Instant::now();
-            for _ in 0..inner {
-                f();
-            }
-            start.elapsed().as_secs_f64() * 1e9 / inner as f64
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    t[t.len() / 2]
 }
 
 /// A bit mask that also counts what it is sent (the timing sink).
@@ -247,25 +246,18 @@ fn coverage_errors(
     }
 }
 
-/// Median time of rasterizing every triangle with `f` into `sink`, and the pixels
-/// sent. Generic so the rasterizer inlines: nothing is dispatched per triangle.
-fn time_coverage<F: Fn(Tri2, &mut Counted)>(
-    tris: &[Tri2],
-    repeats: usize,
-    sink: &mut Counted,
-    f: F,
-) -> (f64, u64) {
-    let ns = median_ns(repeats, || {
-        sink.mask.clear();
-        sink.n = 0;
-        for &t in tris {
-            f(t, sink);
-        }
-    });
-    (ns, sink.n)
+/// Rasterizes every triangle with `f` into `sink` (cleared first). Generic so the
+/// rasterizer inlines into the sink.
+fn cover_all<F: Fn(Tri2, &mut Counted)>(tris: &[Tri2], sink: &mut Counted, f: F) {
+    sink.mask.clear();
+    sink.n = 0;
+    for &t in tris {
+        f(t, sink);
+    }
 }
 
-/// The edge-arithmetic and traversal rows of one 2D workload.
+/// The edge-arithmetic and traversal rows of one 2D workload. Each family's variants
+/// are timed in interleaved rounds.
 fn coverage_rows(
     workload: &'static str,
     tris: &[Tri2],
@@ -282,10 +274,14 @@ fn coverage_rows(
         mask: BitMask::new(target.width, target.height),
         n: 0,
     };
-    for v in EdgeArith::ALL {
-        let (ns, pixels) = time_coverage(tris, config.repeats, &mut sink, |t, s| {
-            v.rasterize(t, target, s);
-        });
+    let edge = |v: EdgeArith, sink: &mut Counted| {
+        cover_all(tris, sink, |t, s| v.rasterize(t, target, s));
+    };
+    let times = measure_each(&config.timing, EdgeArith::ALL.len(), |i| {
+        edge(EdgeArith::ALL[i], &mut sink);
+    });
+    for (v, time) in EdgeArith::ALL.into_iter().zip(times) {
+        edge(v, &mut sink);
         let errors = coverage_errors(tris, &oracle, target, watertight, |t, out| {
             v.rasterize(t, target, out);
         });
@@ -295,17 +291,23 @@ fn coverage_rows(
             workload,
             target,
             triangles: tris.len() as u64,
-            pixels,
-            median_ns: ns,
+            pixels: sink.n,
+            time,
             errors,
         });
     }
-    for tr in Traversal::ALL {
-        let (ns, pixels) = time_coverage(tris, config.repeats, &mut sink, |t, s| {
+    let traverse = |tr: Traversal, sink: &mut Counted| {
+        cover_all(tris, sink, |t, s| {
             if let Ok(setup) = Setup::new(t, target) {
                 tr.run(&setup, s);
             }
         });
+    };
+    let times = measure_each(&config.timing, Traversal::ALL.len(), |i| {
+        traverse(Traversal::ALL[i], &mut sink);
+    });
+    for (tr, time) in Traversal::ALL.into_iter().zip(times) {
+        traverse(tr, &mut sink);
         let errors = coverage_errors(tris, &oracle, target, watertight, |t, out| {
             if let Ok(setup) = Setup::new(t, target) {
                 tr.run(&setup, out);
@@ -317,8 +319,8 @@ fn coverage_rows(
             workload,
             target,
             triangles: tris.len() as u64,
-            pixels,
-            median_ns: ns,
+            pixels: sink.n,
+            time,
             errors,
         });
     }
@@ -333,15 +335,16 @@ fn aa_rows(
     rows: &mut Vec<Row>,
 ) {
     let mut ss = Supersampled::default();
-    for samples in SAMPLE_COUNTS {
-        let mut pixels = 0u64;
-        let ns = median_ns(config.repeats, || {
-            pixels = 0;
-            for &t in tris {
-                supersample(t, target, samples, &mut ss);
-                pixels += ss.counts.iter().filter(|&&c| c > 0).count() as u64;
-            }
-        });
+    let mut pixels = [0u64; SAMPLE_COUNTS.len()];
+    let times = measure_each(&config.timing, SAMPLE_COUNTS.len(), |i| {
+        let mut n = 0;
+        for &t in tris {
+            supersample(t, target, SAMPLE_COUNTS[i], &mut ss);
+            n += ss.counts.iter().filter(|&&c| c > 0).count() as u64;
+        }
+        pixels[i] = n;
+    });
+    for ((samples, time), pixels) in SAMPLE_COUNTS.into_iter().zip(times).zip(pixels) {
         let (mut sum, mut n, mut max) = (0.0, 0u64, 0.0f64);
         for &t in tris {
             let Some(exact) = snapped(t) else { continue };
@@ -360,7 +363,7 @@ fn aa_rows(
             target,
             triangles: tris.len() as u64,
             pixels,
-            median_ns: ns,
+            time,
             errors: Errors {
                 aa_mean: Some(if n == 0 { 0.0 } else { sum / n as f64 }),
                 aa_max: Some(max),
@@ -415,19 +418,21 @@ fn interpolation_rows(scene: &Scene3, target: Target, config: &Config, rows: &mu
             })
             .collect()
     });
-    for mode in Interpolation::ALL {
+    let mut draw = |mode: Interpolation, out: &mut UvTarget| {
         let opts = DrawOptions {
             interpolation: mode,
             ..DrawOptions::default()
         };
-        let mut draw = |out: &mut UvTarget| {
-            renderer.begin_frame(target, out, Vec3::ZERO);
-            transform(&shader, scene.positions.len(), &mut cache);
-            renderer.draw(&shader, &cache, &scene.indices, &opts, out);
-        };
-        let ns = median_ns(config.repeats, || draw(&mut out));
-        draw(&mut out);
-        let stats = renderer.stats;
+        renderer.begin_frame(target, out, Vec3::ZERO);
+        transform(&shader, scene.positions.len(), &mut cache);
+        renderer.draw(&shader, &cache, &scene.indices, &opts, out);
+        renderer.stats
+    };
+    let times = measure_each(&config.timing, Interpolation::ALL.len(), |i| {
+        draw(Interpolation::ALL[i], &mut out);
+    });
+    for (mode, time) in Interpolation::ALL.into_iter().zip(times) {
+        let stats = draw(mode, &mut out);
         let errors = exact.as_ref().map_or(Errors::default(), |exact| {
             let mut e = [(0.0, 0.0f64); 2];
             let mut n = 0u64;
@@ -461,7 +466,7 @@ fn interpolation_rows(scene: &Scene3, target: Target, config: &Config, rows: &mu
             target,
             triangles: stats.drawn,
             pixels: stats.shaded,
-            median_ns: ns,
+            time,
             errors,
         });
     }
@@ -491,49 +496,62 @@ pub const CLOSE_PLANE_DISTANCES: [f32; 4] = [0.3, 1.0, 3.0, 9.0];
 /// Gaps between the planes as fractions of their distance.
 pub const CLOSE_PLANE_GAPS: [f32; 3] = [1e-3, 1e-4, 1e-5];
 
-/// The depth rows: z-fighting on close planes, and the bunny for speed.
+/// The depth rows: z-fighting on close planes, and the bunny for speed. The close
+/// planes are timed as one run through every distance, gap and draw order.
 fn depth_rows(target: Target, config: &Config, rows: &mut Vec<Row>) {
     const QUAD: [u32; 6] = [0, 1, 2, 0, 2, 3];
     let cam = crate::camera::Camera::default();
     let vp = cam.projection(target.width, target.height, 1.0) * cam.view();
     let bunny = workloads::bunny_scene();
-    for format in DepthFormat::ALL {
-        let matrix = format.projection(vp);
-        let mut pass = DepthPass::new(target, format);
+    // (first drawn, its id, second drawn, its id): the farther plane has id 0.
+    let mut pairs: Vec<[(Vec<Vec3>, u32); 2]> = Vec::new();
+    for d in CLOSE_PLANE_DISTANCES {
+        for g in CLOSE_PLANE_GAPS {
+            let [far, near] = close_planes(d, d * g);
+            pairs.push([(far.clone(), 0), (near.clone(), 1)]);
+            pairs.push([(near, 1), (far, 0)]);
+        }
+    }
+    let mut passes: Vec<DepthPass> = DepthFormat::ALL
+        .iter()
+        .map(|&f| DepthPass::new(target, f))
+        .collect();
+    let matrices = DepthFormat::ALL.map(|f| f.projection(vp));
+    let bunny_matrices = DepthFormat::ALL.map(|f| f.projection(bunny.view_proj(target)));
+    let planes = |pass: &mut DepthPass, matrix: Mat4, pair: &[(Vec<Vec3>, u32); 2]| {
+        pass.clear();
+        for (p, id) in pair {
+            pass.draw(p, &QUAD, matrix, *id);
+        }
+    };
+    let times = measure_each(&config.timing, passes.len(), |i| {
+        for pair in &pairs {
+            planes(&mut passes[i], matrices[i], pair);
+        }
+    });
+    let bunny_times = measure_each(&config.timing, passes.len(), |i| {
+        let pass = &mut passes[i];
+        pass.clear();
+        pass.draw(&bunny.positions, &bunny.indices, bunny_matrices[i], 0);
+    });
+    for (i, pass) in passes.iter_mut().enumerate() {
+        let format = DepthFormat::ALL[i];
         let (mut wrong, mut total, mut fragments) = (0u64, 0u64, 0u64);
-        let mut ns = 0.0;
-        let mut triangles = 0;
-        for d in CLOSE_PLANE_DISTANCES {
-            for g in CLOSE_PLANE_GAPS {
-                let [far, near] = close_planes(d, d * g);
-                for near_first in [false, true] {
-                    let order: [(&[Vec3], u32); 2] = if near_first {
-                        [(&near, 1), (&far, 0)]
-                    } else {
-                        [(&far, 0), (&near, 1)]
-                    };
-                    ns += median_ns(config.repeats, || {
-                        pass.clear();
-                        for (p, id) in order {
-                            pass.draw(p, &QUAD, matrix, id);
-                        }
-                    });
-                    triangles += 4;
-                    fragments += pass.fragments;
-                    // Pixels both planes cover: the ids show which won.
-                    total += pass.ids.iter().filter(|&&i| i != u32::MAX).count() as u64;
-                    wrong += pass.ids.iter().filter(|&&i| i == 0).count() as u64;
-                }
-            }
+        for pair in &pairs {
+            planes(pass, matrices[i], pair);
+            fragments += pass.fragments;
+            // Pixels both planes cover: the ids show which won.
+            total += pass.ids.iter().filter(|&&i| i != u32::MAX).count() as u64;
+            wrong += pass.ids.iter().filter(|&&i| i == 0).count() as u64;
         }
         rows.push(Row {
             family: Family::Depth,
             variant: format.name(),
             workload: "close-planes",
             target,
-            triangles,
+            triangles: 2 * QUAD.len() as u64 / 3 * pairs.len() as u64,
             pixels: fragments,
-            median_ns: ns,
+            time: times[i],
             errors: Errors {
                 zfight: Some(if total == 0 {
                     0.0
@@ -543,11 +561,8 @@ fn depth_rows(target: Target, config: &Config, rows: &mut Vec<Row>) {
                 ..Errors::default()
             },
         });
-        let matrix = format.projection(bunny.view_proj(target));
-        let ns = median_ns(config.repeats, || {
-            pass.clear();
-            pass.draw(&bunny.positions, &bunny.indices, matrix, 0);
-        });
+        pass.clear();
+        pass.draw(&bunny.positions, &bunny.indices, bunny_matrices[i], 0);
         rows.push(Row {
             family: Family::Depth,
             variant: format.name(),
@@ -555,7 +570,7 @@ fn depth_rows(target: Target, config: &Config, rows: &mut Vec<Row>) {
             target,
             triangles: (bunny.indices.len() / 3) as u64,
             pixels: pass.fragments,
-            median_ns: ns,
+            time: bunny_times[i],
             errors: Errors::default(),
         });
     }

@@ -10,6 +10,7 @@ pub mod line_cmd;
 pub mod link_cmd;
 pub mod raster_cmd;
 pub mod render_cmd;
+pub mod suggest;
 pub mod view_cmd;
 
 use std::io::{self, Write};
@@ -153,7 +154,12 @@ pub const MAX_PIXELS: u64 = 1 << 25;
 
 /// Runs the parsed command line, writing errors to stderr.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let args: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    // Before clap: it would take a mistyped subcommand for the viewer's model.
+    if let Some(e) = suggest::mistyped_subcommand(&args) {
+        e.exit();
+    }
+    let cli = Cli::parse_from(args);
     let result: Result<(), CliError> = match cli.command {
         Some(Command::Raster(args)) => {
             raster_cmd::run(&args, io::stdin().lock(), io::stdout().lock()).map_err(Into::into)

@@ -56,6 +56,8 @@ pub enum MeshError {
     },
     #[error("{path}: no triangles")]
     Empty { path: PathBuf },
+    #[error("{path}: not an OBJ file: {why}")]
+    NotObj { path: PathBuf, why: String },
     #[error(
         "unknown built-in model `{0}` (try `teapot`, `bunny`, `sphere:N` with N from 1 to 4194304, or an OBJ path)"
     )]
@@ -164,13 +166,29 @@ impl Mesh {
         Ok(m)
     }
 
-    /// Loads an OBJ file (triangulated, single index), unnormalised.
+    /// Loads an OBJ file (triangulated, single index), unnormalised. A file that is
+    /// not text, or does not parse and starts like another format (see
+    /// [`NOT_OBJ`]), is refused saying what it looks like.
     pub fn load(path: &Path) -> Result<Self, MeshError> {
-        let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
+        let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
             path: path.into(),
             source,
         })?;
-        let mut m = parse_obj(&text, path)?;
+        let not_obj = |why| MeshError::NotObj {
+            path: path.into(),
+            why,
+        };
+        let looks_like = |bytes: &[u8]| sniff(bytes).map(|what| format!("it looks like {what}"));
+        let text = String::from_utf8(bytes).map_err(|e| {
+            not_obj(looks_like(e.as_bytes()).unwrap_or_else(|| {
+                format!(
+                    "it is not text (byte {} is not UTF-8)",
+                    e.utf8_error().valid_up_to()
+                )
+            }))
+        })?;
+        let mut m =
+            parse_obj(&text, path).map_err(|e| looks_like(text.as_bytes()).map_or(e, not_obj))?;
         m.name = path.display().to_string();
         Ok(m)
     }
@@ -240,6 +258,36 @@ impl fmt::Display for Mesh {
             self.triangle_count()
         )
     }
+}
+
+/// How common files that are not OBJ text start: (offset, bytes, what the file is).
+/// Consulted only for a file that is not UTF-8 or does not parse as OBJ, so no OBJ
+/// that loads is refused (not even one whose first line is `solid` or `ply`).
+pub const NOT_OBJ: &[(usize, &[u8], &str)] = &[
+    (0, b"\x89PNG\r\n\x1a\n", "a PNG image"),
+    (0, b"\xff\xd8\xff", "a JPEG image"),
+    (0, b"GIF8", "a GIF image"),
+    (8, b"WEBP", "a WebP image"),
+    (0, b"II*\0", "a TIFF image"),
+    (0, b"MM\0*", "a TIFF image"),
+    (0, b"%PDF-", "a PDF document"),
+    (0, b"PK\x03\x04", "a ZIP archive"),
+    (0, b"\x1f\x8b", "a gzip file"),
+    (0, b"\xfd7zXZ\0", "an xz file"),
+    (0, b"\x28\xb5\x2f\xfd", "a zstd file"),
+    (0, b"\x7fELF", "an ELF executable"),
+    (0, b"glTF", "a binary glTF model (convert it to OBJ)"),
+    (0, b"ply", "a PLY model (convert it to OBJ)"),
+    (0, b"solid", "an STL model (convert it to OBJ)"),
+];
+
+/// What a file that starts with `bytes` looks like, by [`NOT_OBJ`].
+#[must_use]
+pub fn sniff(bytes: &[u8]) -> Option<&'static str> {
+    NOT_OBJ
+        .iter()
+        .find(|(at, magic, _)| bytes.get(*at..).is_some_and(|b| b.starts_with(magic)))
+        .map(|(_, _, what)| *what)
 }
 
 /// Parses OBJ text with tobj and merges its models into one mesh.

@@ -15,6 +15,7 @@ use ratatui::widgets::{Block, Widget};
 
 use crate::accuracy::cases::{self, HardCase};
 use crate::accuracy::edge::EdgeArith;
+use crate::accuracy::timing::{Comparison, Timing};
 use crate::accuracy::{Config, Errors, Family, Row, run};
 use crate::raster::Target;
 
@@ -62,7 +63,8 @@ pub fn run_cmd(args: &AccuracyArgs, out: &mut impl Write) -> Result<(), super::C
 pub struct Summary {
     pub family: Option<Family>,
     pub variant: &'static str,
-    pub ns: f64,
+    /// Nanoseconds of one run of every workload: medians and interval ends summed.
+    pub time: Timing,
     pub triangles: u64,
     pub pixels: u64,
     /// Summed counts, the largest maxima, and means averaged over the workloads.
@@ -73,13 +75,30 @@ impl Summary {
     /// Nanoseconds per triangle over all workloads.
     #[must_use]
     pub fn ns_per_triangle(&self) -> f64 {
-        self.ns / self.triangles.max(1) as f64
+        self.time.median / self.triangles.max(1) as f64
     }
 
     /// Million pixels per second over all workloads.
     #[must_use]
     pub fn mpx_per_s(&self) -> f64 {
-        self.pixels as f64 / self.ns.max(1.0) * 1e3
+        self.pixels as f64 / self.time.median.max(1.0) * 1e3
+    }
+
+    /// Against the family's baseline variant: `baseline` for itself, `within noise`
+    /// when the intervals overlap, else the difference in per cent of the baseline.
+    #[must_use]
+    pub fn versus(&self, base: &Summary) -> String {
+        if self.variant == base.variant {
+            return "baseline".into();
+        }
+        match self.time.compare(&base.time) {
+            Comparison::WithinNoise => "within noise".into(),
+            Comparison::Slower | Comparison::Faster => {
+                let pct =
+                    (self.time.median / base.time.median.max(f64::MIN_POSITIVE) - 1.0) * 100.0;
+                format!("{pct:+.0}%")
+            }
+        }
     }
 
     /// The family's headline error (what the chart plots).
@@ -132,7 +151,7 @@ pub fn summarize(rows: &[Row], family: Family, size: Target) -> Vec<Summary> {
         };
         let s = &mut out[i];
         let e = &r.errors;
-        s.ns += r.median_ns;
+        s.time = s.time.plus(&r.time);
         s.triangles += r.triangles;
         s.pixels += r.pixels;
         let t = &mut s.errors;
@@ -175,11 +194,17 @@ fn opt_e(v: Option<f64>) -> String {
 #[must_use]
 pub fn report(rows: &[Row], config: &Config, hard: &[HardCase]) -> String {
     let mut s = String::new();
+    let p = &config.timing;
     let _ = writeln!(
         s,
-        "termrast bench accuracy{}: median of {} runs per measurement\n",
+        "termrast bench accuracy{}: median of at least {} rounds per measurement, more until \
+         its 95% interval is within ±{}% or {} ms are spent; ± is that interval summed over \
+         the workloads; \"within noise\": the intervals of a variant and its family's \
+         baseline overlap\n",
         if config.scale < 1.0 { " --quick" } else { "" },
-        config.repeats
+        p.min_rounds,
+        p.target_spread * 100.0,
+        p.budget.as_millis(),
     );
     for &size in &config.sizes {
         let _ = writeln!(s, "== {}x{} ==", size.width, size.height);
@@ -233,18 +258,28 @@ pub fn report(rows: &[Row], config: &Config, hard: &[HardCase]) -> String {
                     )
                 }),
             };
+            let base = sums
+                .iter()
+                .find(|m| m.variant == family.baseline())
+                .unwrap_or(&sums[0]);
             let _ = writeln!(
                 s,
-                "  {:<20} {:>10} {:>10}  {h}",
-                "variant", "ns/tri", "Mpx/s"
+                "  {:<20} {:>10} {:>7} {:>10}  {:<14}  {h}",
+                "variant",
+                "ns/tri",
+                "±",
+                "Mpx/s",
+                format!("vs {}", base.variant)
             );
             for m in &sums {
                 let _ = writeln!(
                     s,
-                    "  {:<20} {:>10.1} {:>10.1}  {}",
+                    "  {:<20} {:>10.1} {:>7} {:>10.1}  {:<14}  {}",
                     m.variant,
                     m.ns_per_triangle(),
+                    m.time.spread_label(),
                     m.mpx_per_s(),
+                    m.versus(base),
                     cols(m)
                 );
             }
@@ -277,11 +312,13 @@ pub fn report(rows: &[Row], config: &Config, hard: &[HardCase]) -> String {
     s
 }
 
-/// Every row as CSV with a header.
+/// Every row as CSV with a header: the measurements, then the time's interval
+/// (`ns_low`, `ns_high`, the 95 % interval of `median_ns`), its spread in per cent and
+/// the rounds it was measured over.
 #[must_use]
 pub fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
-        "family,variant,workload,width,height,triangles,pixels,median_ns,ns_per_triangle,mpx_per_s,mismatches,holes,double_hits,attr_max,attr_mean,attr_max_px,attr_mean_px,aa_mean,aa_max,zfight\n",
+        "family,variant,workload,width,height,triangles,pixels,median_ns,ns_per_triangle,mpx_per_s,mismatches,holes,double_hits,attr_max,attr_mean,attr_max_px,attr_mean_px,aa_mean,aa_max,zfight,ns_low,ns_high,spread_pct,rounds\n",
     );
     let u = |v: Option<u64>| v.map(|v| v.to_string()).unwrap_or_default();
     let f = |v: Option<f64>| v.map(|v| format!("{v:e}")).unwrap_or_default();
@@ -289,7 +326,7 @@ pub fn csv(rows: &[Row]) -> String {
         let e = &r.errors;
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{:.0},{:.2},{:.3},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{:.0},{:.2},{:.3},{},{},{},{},{},{},{},{},{},{},{:.0},{:.0},{:.2},{}",
             r.family.name(),
             r.variant,
             r.workload,
@@ -297,7 +334,7 @@ pub fn csv(rows: &[Row]) -> String {
             r.target.height,
             r.triangles,
             r.pixels,
-            r.median_ns,
+            r.time.median,
             r.ns_per_triangle(),
             r.mpx_per_s(),
             u(e.mismatches),
@@ -310,6 +347,10 @@ pub fn csv(rows: &[Row]) -> String {
             f(e.aa_mean),
             f(e.aa_max),
             f(e.zfight),
+            r.time.low,
+            r.time.high,
+            r.time.spread() * 100.0,
+            r.time.rounds,
         );
     }
     s

@@ -7,10 +7,14 @@ use std::io::{self, Write};
 use clap::{Args, ValueEnum};
 
 use crate::raster::Target;
-use crate::raster::line::{Line, LineRangeError, NoTrace, Step};
+use crate::raster::line::{Line, LineRangeError, MAX_LINE_COORD, NoTrace, Step};
 
 /// Largest grid printed without `--size`.
 const MAX_GRID_SIDE: i64 = 400;
+
+/// Most pixels `--trace` or `--format cells` shows (with `--size`, of the part inside
+/// the target): about 100 MB of steps and text. Checked before the walk.
+pub const MAX_LISTED: i64 = 1_000_000;
 
 /// Arguments of `termrast line`.
 #[derive(Debug, Args)]
@@ -20,10 +24,12 @@ pub struct LineArgs {
     pub y0: i64,
     pub x1: i64,
     pub y1: i64,
-    /// Print the decision table: d before each step, E or NE, d after.
+    /// Print the decision table: d before each step, E or NE, d after (at most
+    /// 1000000 steps; with --size only the pixels inside count).
     #[arg(long)]
     pub trace: bool,
-    /// `grid` draws the pixels (`#`), `cells` lists them as `x,y`.
+    /// `grid` draws the pixels (`#`; at most 400×400 without --size), `cells` lists
+    /// them as `x,y` (at most 1000000; with --size only the pixels inside count).
     #[arg(long, value_enum, default_value_t = LineFormat::Grid)]
     pub format: LineFormat,
     /// Clip to a WxH target (only pixels inside it are drawn and traced).
@@ -43,6 +49,13 @@ pub enum LineFormat {
 pub enum LineError {
     #[error(transparent)]
     Range(#[from] LineRangeError),
+    #[error("coordinate {0} is out of range: line coordinates must be within ±2^40")]
+    Coordinate(i64),
+    #[error(
+        "the line has {pixels} pixels; {what} shows at most {MAX_LISTED} \
+         (with --size WxH, only those inside count)"
+    )]
+    TooManyPixels { pixels: i64, what: &'static str },
     #[error("the grid would be {0}×{1} cells; use --format cells or --size WxH")]
     GridTooLarge(i64, i64),
     #[error(transparent)]
@@ -102,8 +115,56 @@ pub fn trace_table(line: &Line, steps: &[Step]) -> String {
 }
 
 /// Runs `termrast line`.
+///
+/// Every size is checked before the walk, so a line too long to show fails at once
+/// in bounded memory.
 pub fn run(args: &LineArgs, out: &mut impl Write) -> Result<(), LineError> {
+    let coords = [args.x0, args.y0, args.x1, args.y1];
+    if let Some(&c) = coords
+        .iter()
+        .find(|c| c.unsigned_abs() > MAX_LINE_COORD as u64)
+    {
+        return Err(LineError::Coordinate(c));
+    }
     let line = Line::new((args.x0, args.y0), (args.x1, args.y1))?;
+    // Pixels the walk visits: the whole line, or its part inside the target.
+    let walked = match args.size {
+        Some(t) => line
+            .clip_range(t.width.into(), t.height.into())
+            .map_or(0, |(k0, k1)| k1 - k0 + 1),
+        None => line.len(),
+    };
+    let what = match (args.trace, args.format) {
+        (true, LineFormat::Cells) => Some("--trace with --format cells"),
+        (true, LineFormat::Grid) => Some("--trace"),
+        (false, LineFormat::Cells) => Some("--format cells"),
+        (false, LineFormat::Grid) => None,
+    };
+    if let Some(what) = what
+        && walked > MAX_LISTED
+    {
+        return Err(LineError::TooManyPixels {
+            pixels: walked,
+            what,
+        });
+    }
+    // The grid's extent: the target, or the line's bounding box.
+    let (x0, y0, x1, y1) = match args.size {
+        Some(t) => (0, 0, i64::from(t.width) - 1, i64::from(t.height) - 1),
+        None => (
+            args.x0.min(args.x1),
+            args.y0.min(args.y1),
+            args.x0.max(args.x1),
+            args.y0.max(args.y1),
+        ),
+    };
+    let (w, h) = (x1 - x0 + 1, y1 - y0 + 1);
+    if args.format == LineFormat::Grid
+        && args.size.is_none()
+        && (w > MAX_GRID_SIDE || h > MAX_GRID_SIDE)
+    {
+        return Err(LineError::GridTooLarge(w, h));
+    }
     let mut pixels = Vec::new();
     let mut steps: Vec<Step> = Vec::new();
     let plot = |x, y| pixels.push((x, y));
@@ -122,19 +183,6 @@ pub fn run(args: &LineArgs, out: &mut impl Write) -> Result<(), LineError> {
             writeln!(out, "{}", cells.join(" "))?;
         }
         LineFormat::Grid => {
-            let (x0, y0, x1, y1) = match args.size {
-                Some(t) => (0, 0, i64::from(t.width) - 1, i64::from(t.height) - 1),
-                None => (
-                    args.x0.min(args.x1),
-                    args.y0.min(args.y1),
-                    args.x0.max(args.x1),
-                    args.y0.max(args.y1),
-                ),
-            };
-            let (w, h) = (x1 - x0 + 1, y1 - y0 + 1);
-            if w > MAX_GRID_SIDE || h > MAX_GRID_SIDE {
-                return Err(LineError::GridTooLarge(w, h));
-            }
             let mut grid = vec![b'.'; (w * h) as usize];
             for (x, y) in &pixels {
                 grid[((y - y0) * w + (x - x0)) as usize] = b'#';

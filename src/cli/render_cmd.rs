@@ -66,7 +66,7 @@ pub struct PngArgs {
     /// Rotation about y in radians (of the first frame).
     #[arg(long, default_value_t = 0.6, allow_negative_numbers = true)]
     pub angle: f32,
-    /// Write one frame as a PNG file instead of text.
+    /// Write one frame as a PNG file instead of text (the name must end in `.png`).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Text frames: number of frames (each turns the model by 0.05 rad).
@@ -102,8 +102,8 @@ pub struct BenchRenderArgs {
     /// Frames to render (each turns the model by 0.05 rad).
     #[arg(long, default_value_t = 100)]
     pub frames: u32,
-    /// Rendering threads (the renderer is single-threaded; only 1 is accepted).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1))]
+    /// Rendering threads: only 1 is accepted (the renderer is single-threaded).
+    #[arg(long, default_value_t = 1, value_parser = parse_threads)]
     pub threads: u32,
     /// The draw loop's instruction set: baseline, avx2 or avx512 (default: the best
     /// this CPU has). All give identical images.
@@ -111,8 +111,40 @@ pub struct BenchRenderArgs {
     pub isa: Option<Isa>,
 }
 
+/// `--threads`: the renderer is single-threaded, so only 1 is meaningful.
+fn parse_threads(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(1) => Ok(1),
+        Ok(_) => Err("the renderer is single-threaded: only 1 is accepted".into()),
+        Err(_) => Err(format!("`{s}` is not a whole number (only 1 is accepted)")),
+    }
+}
+
+/// Refuses an `--out` path that is not a PNG, before anything is rendered or created
+/// (only PNG is written; a failed save would leave an empty file behind).
+fn check_png_path(path: &Path) -> Result<(), super::CliError> {
+    let is_png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if is_png {
+        return Ok(());
+    }
+    let not = match path.extension() {
+        Some(e) => format!(", not `.{}`", e.to_string_lossy()),
+        None => String::new(),
+    };
+    Err(super::CliError::Usage(format!(
+        "{}: --out writes PNG images only{not}; name the file `{}`",
+        path.display(),
+        path.with_extension("png").display()
+    )))
+}
+
 /// Writes frames of the standard scene as ANSI text, or one as a PNG with `--out`.
 pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
+    if let Some(out) = &args.out {
+        check_png_path(out)?;
+    }
     if args.plan {
         let scene = if is_scene_path(&args.scene.model) {
             Scene::load(Path::new(&args.scene.model))?
@@ -264,6 +296,13 @@ impl std::fmt::Display for BenchReport {
 
 /// Runs the standard benchmark: clear colour and depth, draw, per frame.
 pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliError> {
+    if is_scene_path(&args.scene.model) {
+        return Err(super::CliError::Usage(format!(
+            "{0}: bench render times a model (`teapot`, `bunny`, `sphere:N` or an OBJ file), \
+             not a scene file; `termrast render {0}` draws the scene",
+            args.scene.model
+        )));
+    }
     let model = args.scene.model()?;
     let target = args.size;
     let opts = args.scene.options();

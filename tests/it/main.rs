@@ -6,6 +6,7 @@ mod common;
 
 mod accuracy;
 mod bytes;
+mod cli_mistakes;
 mod cli_raster;
 mod coverage;
 mod framing;

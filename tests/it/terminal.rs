@@ -259,6 +259,108 @@ fn inspector_and_line_panel_snapshots() {
     insta::assert_snapshot!("screen_inspect", screen(&t));
 }
 
+fn key(a: &mut App, code: ratatui::crossterm::event::KeyCode) {
+    use ratatui::crossterm::event::{Event, KeyEvent};
+    a.handle(&Event::Key(KeyEvent::from(code)));
+}
+
+fn status_line(t: &Terminal<TestBackend>) -> String {
+    let text = t.backend().to_string();
+    text.lines().last().unwrap_or_default().to_string()
+}
+
+/// The status line says what is drawn: culling on or off, the lines of a wireframe;
+/// no frame rate while paused; `p` on a model says there is no plan.
+#[test]
+fn the_status_line_says_what_is_drawn() {
+    use ratatui::crossterm::event::KeyCode;
+    let mut a = app(GlyphMode::Blocks);
+    let mut t = Terminal::new(TestBackend::new(200, 40)).unwrap();
+    t.draw(|f| a.draw(f)).unwrap();
+    let s = status_line(&t);
+    assert!(
+        s.contains("fill no cull") && s.contains("paused") && !s.contains("fps"),
+        "{s}"
+    );
+    key(&mut a, KeyCode::Char('b'));
+    key(&mut a, KeyCode::Char('w'));
+    t.draw(|f| a.draw(f)).unwrap();
+    let s = status_line(&t);
+    let lines: u64 = s
+        .split_once("wire ")
+        .and_then(|(_, r)| r.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .expect("a line count");
+    assert!(lines > 100 && s.contains(" cull"), "{s}");
+    key(&mut a, KeyCode::Char('p'));
+    t.draw(|f| a.draw(f)).unwrap();
+    assert!(
+        status_line(&t).contains("no scene plan"),
+        "{}",
+        status_line(&t)
+    );
+}
+
+/// A scene's line panel traces its objects' edges, and stepping moves the cursor.
+#[test]
+fn the_line_panel_works_for_scenes() {
+    use ratatui::crossterm::event::KeyCode;
+    let scene =
+        termrast::scene::Scene::load(std::path::Path::new("examples/scenes/lit-teapot.toml"))
+            .unwrap();
+    let mut a = App::with_scene(
+        scene,
+        ViewSettings {
+            glyphs: GlyphMode::Blocks,
+            colors: ColorMode::Truecolor,
+            ..ViewSettings::default()
+        },
+    );
+    let mut t = Terminal::new(TestBackend::new(140, 45)).unwrap();
+    key(&mut a, KeyCode::Char('i'));
+    t.draw(|f| a.draw(f)).unwrap();
+    let screen = t.backend().to_string();
+    assert!(screen.contains("object 0 edge v"), "{screen}");
+    assert!(!screen.contains("no line here"), "{screen}");
+    let before = (a.cursor, a.sub);
+    for _ in 0..5 {
+        key(&mut a, KeyCode::Char(']'));
+    }
+    assert_ne!(
+        (a.cursor, a.sub),
+        before,
+        "stepping did not move the cursor"
+    );
+    assert!(a.line_focus.is_some_and(|f| f.object == Some(0)));
+}
+
+/// The plan overlay wraps long lines instead of cutting them.
+#[test]
+fn the_plan_overlay_wraps() {
+    use ratatui::crossterm::event::KeyCode;
+    let scene =
+        termrast::scene::Scene::load(std::path::Path::new("examples/scenes/phong-bunny.toml"))
+            .unwrap();
+    let plan = scene.plan.to_string();
+    let mut a = App::with_scene(scene, ViewSettings::default());
+    let mut t = Terminal::new(TestBackend::new(50, 60)).unwrap();
+    key(&mut a, KeyCode::Char('p'));
+    t.draw(|f| a.draw(f)).unwrap();
+    let screen: String = t
+        .backend()
+        .to_string()
+        .lines()
+        .flat_map(|l| l.split('│').nth(1))
+        .collect::<Vec<_>>()
+        .join(" ");
+    for word in plan.split_whitespace().filter(|w| w.len() > 3) {
+        assert!(
+            screen.contains(word),
+            "`{word}` cut from the plan:\n{screen}"
+        );
+    }
+}
+
 #[test]
 fn tiny_terminal_gets_a_message() {
     let mut a = app(GlyphMode::Braille);

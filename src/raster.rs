@@ -40,7 +40,6 @@ pub mod depth;
 pub mod interp;
 pub mod line;
 pub mod oracle;
-pub mod probe;
 pub mod setup;
 pub mod sink;
 pub mod traverse;

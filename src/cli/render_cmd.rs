@@ -274,7 +274,7 @@ pub struct BenchReport {
     pub triangles: usize,
     /// Covered fragments per frame (mean), overdraw included.
     pub covered_px: u64,
-    /// The instruction set the draw loop ran on (see [`crate::render::Renderer::isa_for`]).
+    /// The instruction set the draw loop ran on (see [`crate::render::DrawCopy::choose`]).
     pub isa: Isa,
 }
 
@@ -333,6 +333,6 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
         min_ms: times[0],
         triangles: model.mesh.triangle_count(),
         covered_px: covered / u64::from(frames),
-        isa: frame.renderer.isa_for::<Lambert<'_>>(&opts),
+        isa: frame.renderer.copy_for::<Lambert<'_>>(&opts).isa,
     })
 }

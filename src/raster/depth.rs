@@ -88,8 +88,8 @@ pub const TILE_H: u32 = 4;
 /// An f32 depth buffer, cleared lazily.
 ///
 /// A clear only marks every `TILE_W × TILE_H` tile *stale* (one bit each): a stale
-/// tile reads as [`DEPTH_CLEAR`] whatever its memory holds. The renderer makes the
-/// tiles under a triangle's bounding box real ([`DepthBuffer::make_real`]) before it
+/// tile reads as [`DEPTH_CLEAR`] whatever its memory holds. The renderer fills the
+/// stale tiles under a triangle's bounding box ([`DepthBuffer::fill_stale`]) before it
 /// walks the triangle, so the far-plane values are written only where something is
 /// drawn, while those lines are being fetched anyway, instead of streaming the whole
 /// buffer through the cache every frame. Readers see the same values either way.
@@ -166,7 +166,7 @@ impl DepthBuffer {
         let tiles_x = width.div_ceil(TILE_W) as usize;
         let tiles_y = height.div_ceil(TILE_H) as usize;
         self.words = tiles_x.div_ceil(64);
-        // Only the bits of real tiles are set, so `resolve` never looks past the edge.
+        // Only the bits of tiles in the buffer are set, so `resolve` never looks past the edge.
         // Refilled in place: a steady viewer allocates nothing here.
         let words = self.words;
         self.stale.clear();
@@ -206,28 +206,28 @@ impl DepthBuffer {
         (0..self.data.len()).map(|i| self.at(i)).collect()
     }
 
-    /// Makes every tile real, so the memory holds what [`DepthBuffer::get`] reads.
+    /// Fills every stale tile, so the memory holds what [`DepthBuffer::get`] reads.
     pub fn resolve(&mut self) {
         let (w, h) = (self.width, self.height);
         if self.has_storage() && w > 0 && h > 0 {
-            self.make_real(0, 0, w - 1, h - 1);
+            self.fill_stale(0, 0, w - 1, h - 1);
         }
     }
 
-    /// Makes the tiles overlapping pixels `x0..=x1` × `y0..=y1` real: stale ones are
-    /// filled with [`DEPTH_CLEAR`]. Costs a word test per tile row when they already
-    /// are: the renderer calls this once per triangle, so a box within one bit word
+    /// Fills the stale tiles overlapping pixels `x0..=x1` × `y0..=y1` with
+    /// [`DEPTH_CLEAR`]. Costs a word test per tile row when none is stale: the
+    /// renderer calls this once per triangle, so a box within one bit word
     /// (every box narrower than 64 tiles that does not cross a word's edge) takes a
     /// loop of its own, with the span computed once.
     #[inline(always)]
-    pub fn make_real(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+    pub fn fill_stale(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
         let (tx0, tx1) = ((x0 / TILE_W) as usize, (x1 / TILE_W) as usize);
         let (ty0, ty1) = ((y0 / TILE_H) as usize, (y1 / TILE_H) as usize);
         let (w0, w1) = (tx0 / 64, tx1 / 64);
         if w0 == w1 {
             let span = word_span(tx0 % 64, tx1 % 64);
             for ty in ty0..ty1 + 1 {
-                self.make_word_real(ty, w0, span);
+                self.fill_stale_word(ty, w0, span);
             }
             return;
         }
@@ -235,14 +235,14 @@ impl DepthBuffer {
             for w in w0..w1 + 1 {
                 let lo = if w == w0 { tx0 % 64 } else { 0 };
                 let hi = if w == w1 { tx1 % 64 } else { 63 };
-                self.make_word_real(ty, w, word_span(lo, hi));
+                self.fill_stale_word(ty, w, word_span(lo, hi));
             }
         }
     }
 
-    /// Makes the stale tiles of `span` in bit word `w` of tile row `ty` real.
+    /// Fills the stale tiles of `span` in bit word `w` of tile row `ty`.
     #[inline(always)]
-    fn make_word_real(&mut self, ty: usize, w: usize, span: u64) {
+    fn fill_stale_word(&mut self, ty: usize, w: usize, span: u64) {
         let word = &mut self.stale[ty * self.words + w];
         let m = *word & span;
         if m != 0 {
@@ -269,9 +269,9 @@ impl DepthBuffer {
         }
     }
 
-    /// The values, row-major, for writers that made the tiles they touch real first.
+    /// The values, row-major, for writers that filled the stale tiles they touch first.
     #[inline(always)]
-    pub(crate) fn real_mut(&mut self) -> &mut [f32] {
+    pub(crate) fn filled_mut(&mut self) -> &mut [f32] {
         &mut self.data
     }
 }
@@ -288,7 +288,7 @@ mod tests {
 
     use super::*;
 
-    /// An operation on a buffer: clear, or make a box real and write a pixel in it.
+    /// An operation on a buffer: clear, or fill a box's stale tiles and write a pixel in it.
     #[derive(Clone, Debug)]
     enum Op {
         Reset,
@@ -334,9 +334,9 @@ mod tests {
                         eager.fill(DEPTH_CLEAR);
                     }
                     Op::Write { x0, y0, x1, y1, at, z } => {
-                        lazy.make_real(x0, y0, x1, y1);
+                        lazy.fill_stale(x0, y0, x1, y1);
                         let i = (at.1 * w + at.0) as usize;
-                        lazy.real_mut()[i] = z;
+                        lazy.filled_mut()[i] = z;
                         eager[i] = z;
                     }
                 }
@@ -345,15 +345,15 @@ mod tests {
             let (x, y) = (w / 2, h / 2);
             prop_assert_eq!(lazy.get(x, y), eager[(y * w + x) as usize]);
             lazy.resolve();
-            prop_assert_eq!(lazy.real_mut(), &eager[..]);
+            prop_assert_eq!(lazy.filled_mut(), &eager[..]);
         }
     }
 
     #[test]
     fn a_clear_hides_the_previous_frame_and_resizes() {
         let mut d = DepthBuffer::new(40, 9);
-        d.make_real(0, 0, 39, 8);
-        d.real_mut().fill(0.25);
+        d.fill_stale(0, 0, 39, 8);
+        d.filled_mut().fill(0.25);
         d.reset(40, 9);
         assert!(d.to_vec().iter().all(|&z| z == DEPTH_CLEAR));
         d.reset(17, 5);

@@ -268,17 +268,3 @@ pub fn span_lerp(wa: [f32; 3], wb: [f32; 3], t: f32) -> [f32; 3] {
         wa[2] + (wb[2] - wa[2]) * t,
     ]
 }
-
-/// Perspective-correct weights (eq. 23) from the edge values `q` weighing each vertex
-/// and `c[i] = (1/w_i) / area2`, plus the interpolated `1/w` itself: `p_i = q_i·c_i`
-/// is `b_i/w_i`, and the weights are `p_i / Σ p_j`. The sum is of non-negative terms
-/// inside the triangle, so it never cancels.
-#[must_use]
-#[inline(always)]
-pub fn perspective_weights(q: [f32; 3], c: [f32; 3]) -> ([f32; 3], f32) {
-    // Same operations, same order, as the renderer's 8-lane path.
-    let p = [q[0] * c[0], q[1] * c[1], q[2] * c[2]];
-    let s = q[2].mul_add(c[2], q[1].mul_add(c[1], p[0]));
-    let r = 1.0 / s;
-    ([p[0] * r, p[1] * r, p[2] * r], s)
-}

@@ -1,11 +1,20 @@
-//! The instruction sets the draw loop is compiled for, and the copies of the loop
-//! built for each.
+//! The copies of the draw loop: instruction sets ([`Isa`]) × variants
+//! ([`DrawVariant`]), and [`DrawCopy::choose`], the one function that picks a copy
+//! for a draw (the table of what is compiled is in [`crate::render`]'s module doc).
 //!
-//! Each copy is a free function in its own module on purpose: the compiler splits a
-//! crate into code-generation units by module (a method goes with its type's module),
-//! so with an explicit unit count (see `Cargo.toml`) the baseline, AVX2 and AVX-512
-//! copies of every shader's draw loop, most of the crate's machine code, are
-//! optimised in parallel instead of in one unit.
+//! Each instruction set's copy is a free function in its own module on purpose: the
+//! compiler splits a crate into code-generation units by module (a method goes with
+//! its type's module), so with an explicit unit count (see `Cargo.toml`) the
+//! baseline, AVX2 and AVX-512 copies of every shader's draw loop, most of the crate's
+//! machine code, are optimised in parallel instead of in one unit.
+
+use super::options::DrawOptions;
+use super::shader::Shader;
+use super::target::ColorTarget;
+use super::{Renderer, VertexCache};
+use crate::raster::Traversal;
+use crate::raster::depth::DepthState;
+use crate::raster::interp::Interpolation;
 
 /// Which instructions the draw loop is compiled for. All give identical bits: only
 /// instruction selection differs (fused multiply-adds are written as such and are
@@ -19,14 +28,10 @@ pub enum Isa {
     /// has them.
     Avx2,
     /// The loop on 16-lane `zmm` registers with AVX-512 (F, VL, BW, DQ): a group is two
-    /// rows of 8 pixels, so the dense meshes' small triangles take half the groups
-    /// (the 65k sphere at 1080p: 297k instead of 579k), and each group has 32 vector
-    /// registers for its per-triangle constants and mask registers for its compares,
-    /// blends and masked stores. Built only for shaders with lane code of their own
-    /// ([`crate::render::Shader::LANE_CODE`]) and the default state
-    /// (depth `Less` with writes, perspective-correct) with the `wide` traversal, the
-    /// path that matters for speed: other draws run the AVX2 copy, which keeps the
-    /// build (and the tests' build) from compiling the whole loop a third time.
+    /// rows of 8 pixels, so the dense meshes' small triangles take half the groups, and
+    /// each group has 32 vector registers for its per-triangle constants and mask
+    /// registers for its compares, blends and masked stores. Built for the [`Fast`] variant of shaders with lane
+    /// code of their own only (see [`DrawCopy::choose`]).
     Avx512,
 }
 
@@ -85,12 +90,167 @@ impl Isa {
     }
 }
 
+/// What a copy of the draw loop fixes at compile time. Implemented by three
+/// zero-sized types, [`Generic`], [`Standard`] and [`Fast`]; the draw loop is generic
+/// over one of them, so an option that is a constant costs no check per group.
+pub trait DrawVariant {
+    /// Depth test `Less` with writes and perspective-correct interpolation are
+    /// constants, whatever [`DrawOptions`] says.
+    const STANDARD_STATE: bool;
+    /// The traversal is `wide`, whatever [`DrawOptions::traversal`] says.
+    const WIDE_ONLY: bool;
+
+    /// Whether a draw with `opts` may run on this variant (it draws them as they say).
+    #[inline(always)]
+    #[must_use]
+    fn admits(opts: &DrawOptions) -> bool {
+        let standard =
+            opts.depth == DepthState::default() && opts.interpolation == Interpolation::Perspective;
+        (!Self::STANDARD_STATE || standard)
+            && (!Self::WIDE_ONLY || opts.traversal == Traversal::Wide)
+    }
+
+    /// The depth state and interpolation a draw with `opts` runs with on this variant:
+    /// constants when [`DrawVariant::STANDARD_STATE`].
+    #[inline(always)]
+    #[must_use]
+    fn state(opts: &DrawOptions) -> (DepthState, Interpolation) {
+        if Self::STANDARD_STATE {
+            (DepthState::default(), Interpolation::Perspective)
+        } else {
+            (opts.depth, opts.interpolation)
+        }
+    }
+}
+
+/// Reads every option at run time: any depth state, interpolation and traversal.
+#[derive(Clone, Copy, Debug)]
+pub struct Generic;
+
+/// The viewer's and the benchmark's state (depth `Less` with writes,
+/// perspective-correct interpolation) as constants, any traversal.
+#[derive(Clone, Copy, Debug)]
+pub struct Standard;
+
+/// [`Standard`] with the `wide` traversal: the one path the AVX-512 copy is built for.
+#[derive(Clone, Copy, Debug)]
+pub struct Fast;
+
+impl DrawVariant for Generic {
+    const STANDARD_STATE: bool = false;
+    const WIDE_ONLY: bool = false;
+}
+
+impl DrawVariant for Standard {
+    const STANDARD_STATE: bool = true;
+    const WIDE_ONLY: bool = false;
+}
+
+impl DrawVariant for Fast {
+    const STANDARD_STATE: bool = true;
+    const WIDE_ONLY: bool = true;
+}
+
+/// Which [`DrawVariant`] a draw runs, as a value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variant {
+    /// [`Generic`].
+    Generic,
+    /// [`Standard`].
+    Standard,
+    /// [`Fast`].
+    Fast,
+}
+
+/// The compiled copy of the draw loop a draw runs on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DrawCopy {
+    pub isa: Isa,
+    pub variant: Variant,
+}
+
+impl DrawCopy {
+    /// The copy for a draw of shader `S` with `opts` into a target `width` pixels wide,
+    /// preferring instruction set `isa`: the most specialised variant that admits the
+    /// options, on `isa` if the CPU has it and that copy is compiled, else the next
+    /// instruction set down. The only place that decides; see the table in
+    /// [`crate::render`].
+    #[must_use]
+    pub fn choose<S: Shader>(isa: Isa, opts: &DrawOptions, width: u32) -> Self {
+        let variant = if Fast::admits(opts) {
+            Variant::Fast
+        } else if Standard::admits(opts) {
+            Variant::Standard
+        } else {
+            Variant::Generic
+        };
+        // Two-row groups have no per-pixel fallback for groups past the target's edge,
+        // so AVX-512 needs a target at least a group wide.
+        let avx512 = S::LANE_CODE && variant == Variant::Fast && width >= 8;
+        let isa = match isa {
+            Isa::Avx512 if avx512 && Isa::Avx512.is_supported() => Isa::Avx512,
+            Isa::Avx2 | Isa::Avx512 if Isa::Avx2.is_supported() => Isa::Avx2,
+            _ => Isa::Baseline,
+        };
+        let variant = match variant {
+            Variant::Fast if isa != Isa::Avx512 => Variant::Standard,
+            v => v,
+        };
+        Self { isa, variant }
+    }
+}
+
+/// Runs `copy` (from [`DrawCopy::choose`]): the one match from the table's cells to
+/// the compiled functions.
+#[inline(always)]
+pub(super) fn run<S: Shader, C: ColorTarget>(
+    copy: DrawCopy,
+    r: &mut Renderer,
+    shader: &S,
+    cache: &VertexCache<S::Varying>,
+    indices: &[u32],
+    opts: &DrawOptions,
+    color: &mut C,
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        // `S::LANE_CODE` first, as its own condition: a constant `false` there keeps
+        // the compiler from building the AVX-512 copy for this shader at all.
+        if S::LANE_CODE && copy.isa == Isa::Avx512 {
+            // SAFETY: `choose` picks an instruction set only when the CPU has it.
+            unsafe { avx512::draw(r, shader, cache, indices, opts, color) };
+            return;
+        }
+        if copy.isa != Isa::Baseline {
+            // SAFETY: as above; AVX-512 implies AVX2.
+            unsafe {
+                match copy.variant {
+                    Variant::Generic => {
+                        avx2::draw::<Generic, _, _>(r, shader, cache, indices, opts, color)
+                    }
+                    Variant::Standard | Variant::Fast => {
+                        avx2::draw::<Standard, _, _>(r, shader, cache, indices, opts, color);
+                    }
+                }
+            }
+            return;
+        }
+    }
+    match copy.variant {
+        Variant::Generic => baseline::draw::<Generic, _, _>(r, shader, cache, indices, opts, color),
+        Variant::Standard | Variant::Fast => {
+            baseline::draw::<Standard, _, _>(r, shader, cache, indices, opts, color);
+        }
+    }
+}
+
 /// The baseline copy: the build's own target, for CPUs without AVX2.
 pub(super) mod baseline {
+    use super::DrawVariant;
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
-    /// The draw loop on [`wide`]'s portable lanes.
-    pub(in crate::render) fn draw<S: Shader, C: ColorTarget>(
+    /// The draw loop of variant `V` on [`wide`]'s portable lanes.
+    pub(in crate::render) fn draw<V: DrawVariant, S: Shader, C: ColorTarget>(
         r: &mut Renderer,
         shader: &S,
         cache: &VertexCache<S::Varying>,
@@ -98,25 +258,27 @@ pub(super) mod baseline {
         opts: &DrawOptions,
         color: &mut C,
     ) {
-        r.draw_triangles::<_, _, wide::i32x8, false>(shader, cache, indices, opts, color);
+        r.draw_triangles::<V, _, _, wide::i32x8>(shader, cache, indices, opts, color);
     }
 }
 
 /// The AVX2 copy.
 #[cfg(target_arch = "x86_64")]
 pub(super) mod avx2 {
+    use super::DrawVariant;
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
-    /// The draw loop compiled with AVX2 and FMA enabled and on [`crate::simd`]'s AVX2
-    /// lanes, so 8-lane values are one 256-bit register instead of two 128-bit halves
-    /// and `mul_add` is one instruction. Only the instruction selection differs: no
-    /// operation is fused or reordered beyond what the code says, so the output is
-    /// bit-identical to the baseline path (the tests compare both).
+    /// The draw loop of variant `V` compiled with AVX2 and FMA enabled and on
+    /// [`crate::simd`]'s AVX2 lanes, so 8-lane values are one 256-bit register instead
+    /// of two 128-bit halves and `mul_add` is one instruction. Only the instruction
+    /// selection differs: no operation is fused or reordered beyond what the code
+    /// says, so the output is bit-identical to the baseline path (the tests compare
+    /// both).
     ///
     /// # Safety
     /// The CPU must have AVX2, FMA, POPCNT and BMI1 ([`super::Isa::Avx2`]).
     #[target_feature(enable = "avx2,fma,popcnt,bmi1")]
-    pub(in crate::render) unsafe fn draw<S: Shader, C: ColorTarget>(
+    pub(in crate::render) unsafe fn draw<V: DrawVariant, S: Shader, C: ColorTarget>(
         r: &mut Renderer,
         shader: &S,
         cache: &VertexCache<S::Varying>,
@@ -124,15 +286,14 @@ pub(super) mod avx2 {
         opts: &DrawOptions,
         color: &mut C,
     ) {
-        r.draw_triangles::<_, _, crate::simd::avx2::I32x8, false>(
-            shader, cache, indices, opts, color,
-        );
+        r.draw_triangles::<V, _, _, crate::simd::avx2::I32x8>(shader, cache, indices, opts, color);
     }
 }
 
-/// The AVX-512 copy, for the default state with the `wide` traversal only.
+/// The AVX-512 copy, of the [`super::Fast`] variant only.
 #[cfg(target_arch = "x86_64")]
 pub(super) mod avx512 {
+    use super::Fast;
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
     /// [`super::avx2::draw`]'s loop on 16 AVX-512 lanes in two-row groups (see
@@ -149,7 +310,7 @@ pub(super) mod avx512 {
         opts: &DrawOptions,
         color: &mut C,
     ) {
-        r.draw_triangles::<_, _, crate::simd::avx512::I32x16, true>(
+        r.draw_triangles::<Fast, _, _, crate::simd::avx512::I32x16>(
             shader, cache, indices, opts, color,
         );
     }

@@ -130,7 +130,8 @@ mod tests {
 
     use super::Lambert;
     use crate::mesh::Mesh;
-    use crate::raster::interp::{Direction, Varying, perspective_weights};
+    use crate::raster::interp::{Direction, Varying};
+    use crate::render::perspective_weights;
     use crate::render::{ShadeLanes, Shader};
     use crate::simd::F32s;
 

@@ -17,7 +17,7 @@ use crate::accuracy::area::grid_side;
 use crate::counters::{self, Stage};
 use crate::raster::Target;
 use crate::raster::depth::{DepthBuffer, DepthState};
-use crate::raster::probe::{Probe, probe_from};
+use crate::render::probe::{Probe, probe_from};
 use crate::render::standard::WIRE_COLOR;
 use crate::render::wire::{
     ScreenLine, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under, project_edge,

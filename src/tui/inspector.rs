@@ -4,8 +4,8 @@
 
 use crate::accuracy::area::grid_side;
 use crate::raster::line::Move;
-use crate::raster::probe::{DepthOutcome, Probe, probe};
 use crate::render::Shader;
+use crate::render::probe::{DepthOutcome, Probe, probe};
 use crate::render::standard::{Model, StandardFrame};
 use crate::render::target::luminance;
 use crate::render::wire::{ScreenLine, line_under, project_edge};

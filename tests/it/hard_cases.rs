@@ -20,9 +20,9 @@ use termrast::raster::clip::{
 use termrast::raster::depth::{DepthFunc, DepthState};
 use termrast::raster::interp::Interpolation;
 use termrast::raster::line::{Line, NoTrace};
-use termrast::raster::probe::probe;
 use termrast::raster::traverse::seed_simd_lanes;
 use termrast::raster::{CountGrid, Reject, Setup, Target, Traversal};
+use termrast::render::probe::probe;
 use termrast::render::{Cull, DrawOptions, Prepared, Renderer, VertexCache, prepare, transform};
 
 const T: Target = Target {

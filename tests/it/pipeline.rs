@@ -9,8 +9,8 @@ use termrast::camera::Camera;
 use termrast::mesh::Mesh;
 use termrast::raster::depth::DEPTH_CLEAR;
 use termrast::raster::interp::{Interpolation, Varying};
-use termrast::raster::probe::{DepthOutcome, probe};
 use termrast::raster::{Target, Traversal};
+use termrast::render::probe::{DepthOutcome, probe};
 use termrast::render::shaders::Lambert;
 use termrast::render::standard::{Model, StandardFrame, StandardView};
 use termrast::render::target::to_u8;
@@ -328,8 +328,16 @@ fn avx512_copy_runs_only_on_targets_a_group_wide_with_lane_shaders() {
         } else {
             next_down
         };
-        assert_eq!(renderer.isa_for::<Lambert>(&opts), want, "{width} wide");
-        assert_eq!(renderer.isa_for::<Direct>(&opts), next_down, "{width} wide");
+        assert_eq!(
+            renderer.copy_for::<Lambert>(&opts).isa,
+            want,
+            "{width} wide"
+        );
+        assert_eq!(
+            renderer.copy_for::<Direct>(&opts).isa,
+            next_down,
+            "{width} wide"
+        );
     }
 }
 

@@ -6,11 +6,11 @@
 //! and replays the depth test. Its answers therefore equal what the renderer did
 //! (the tests check every pixel of a frame).
 
+use super::{DrawOptions, PixelEval, Prepared, VertexCache, prepare};
 use crate::raster::depth::DEPTH_CLEAR;
 use crate::raster::interp::Varying;
 use crate::raster::traverse::{BlockClass, DEFAULT_BLOCK, block_containing, classify_block};
 use crate::raster::{Setup, Target};
-use crate::render::{DrawOptions, PixelEval, Prepared, VertexCache, prepare};
 
 /// Depth-test outcome of one covered fragment.
 #[derive(Clone, Copy, Debug, PartialEq)]

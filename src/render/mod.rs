@@ -1,0 +1,188 @@
+//! The 3D pipeline: vertex transform, clipping, projection, exact setup, traversal,
+//! depth test and shading, one file per stage.
+//!
+//! | file | owns |
+//! |---|---|
+//! | [`shader`] | [`Shader`], [`ShadeLanes`]: vertex and fragment stages, lane code |
+//! | [`options`] | [`DrawOptions`], [`Cull`], [`DrawStats`] |
+//! | [`prepare`](mod@prepare) | vertex cache, transform, [`Projected`], clipping, set-up: [`Prepared`] |
+//! | [`eval`] | the scalar/lane pairs that must agree bit for bit: [`PixelEval`] |
+//! | `fragments` | the coverage sink that tests depth and shades |
+//! | [`probe`](mod@probe) | one pixel's raster state, recomputed on demand |
+//! | `isa` | the compiled copies of the draw loop and the one choice among them |
+//! | this file | [`Renderer`]: frame state and the triangle loop |
+//!
+//! Screen mapping: NDC x ∈ [−1, 1] maps to pixels [0, width] left to right, NDC y ∈
+//! [−1, 1] to [height, 0] (screen space is y-down), and z stays NDC z ∈ [0, 1] for
+//! depth. Faces are front-facing when counter-clockwise in NDC (y-up), i.e. when the
+//! rasterizer had to flip them to positive area in y-down screen space.
+//!
+//! Per-triangle work ([`prepare()`]) and per-pixel work ([`Prepared::eval`]) are shared
+//! by the renderer and the probe, so the probe reports exactly what the renderer did.
+//!
+//! # Copies of the draw loop
+//!
+//! The draw loop is generic over a [`DrawVariant`] (how much of the draw state is a
+//! compile-time constant) and compiled once per instruction set ([`Isa`]).
+//! [`DrawCopy::choose`] picks the copy for a draw; it is the only place that decides.
+//!
+//! | variant \ ISA | baseline | AVX2 | AVX-512 |
+//! |---|---|---|---|
+//! | [`Generic`]: reads every option | yes | yes | no: runs AVX2 |
+//! | [`Standard`]: depth `Less` + write, perspective are constants | yes | yes | no: runs AVX2 |
+//! | [`Fast`]: `Standard` with the `wide` traversal | no: runs `Standard` | no: runs `Standard` | lane-code shaders, targets ≥ 8 px wide |
+//!
+//! Why: `Standard` is the viewer's and the benchmark's state, so its per-group code
+//! has no option checks; every other state shares `Generic`. AVX-512 pays off only for
+//! shaders with lane code of their own ([`Shader::LANE_CODE`]) on the `wide` traversal,
+//! and only on targets at least 8 pixels wide (its two-row groups then never need the
+//! per-pixel fallback), so it is built for `Fast` alone; a third copy of every variant
+//! would mostly lengthen the build. The `Fast` copy's call sits behind the constant
+//! `S::LANE_CODE`, so it is not even compiled for other shaders. No call may sit in a
+//! group loop, taken or not: every vector register is lost across it.
+
+pub mod eval;
+mod fragments;
+mod isa;
+pub mod options;
+pub mod prepare;
+pub mod probe;
+pub mod shader;
+pub mod shaders;
+pub mod standard;
+pub mod target;
+pub mod wire;
+
+use glam::Vec3;
+
+use crate::counters::{self, Stage};
+use crate::raster::Target;
+use crate::raster::depth::DepthBuffer;
+use crate::simd::I32s;
+pub use eval::{PixelEval, perspective_weights};
+use fragments::PieceWalker;
+pub use isa::{DrawCopy, DrawVariant, Fast, Generic, Isa, Standard, Variant};
+pub use options::{Cull, DrawOptions, DrawStats};
+pub use prepare::{
+    EmitPiece, PrepareOutcome, Prepared, Projected, VertexCache, prepare, prepare_projected,
+    project_vertices, transform,
+};
+pub use shader::{ShadeLanes, Shader};
+pub use target::{ColorTarget, Rgba8};
+
+/// Owns the depth buffer and frame counters; draws meshes into a colour target.
+#[derive(Debug)]
+pub struct Renderer {
+    pub target: Target,
+    pub depth: DepthBuffer,
+    pub stats: DrawStats,
+    /// The draw loop's instruction set; [`Isa::detect`] by default.
+    pub isa: Isa,
+    /// The current draw's vertex projections, reused between draws.
+    projected: Vec<Projected>,
+}
+
+impl Renderer {
+    /// A renderer for a target size.
+    #[must_use]
+    pub fn new(target: Target) -> Self {
+        Self {
+            target,
+            depth: DepthBuffer::new(target.width, target.height),
+            stats: DrawStats::default(),
+            isa: Isa::detect(),
+            projected: Vec::new(),
+        }
+    }
+
+    /// Starts a frame: clears depth and colour (reallocating only on resize) and the
+    /// counters.
+    pub fn begin_frame<C: ColorTarget>(&mut self, target: Target, color: &mut C, background: Vec3) {
+        self.begin_frame_with(target, color, background, true);
+    }
+
+    /// Starts a frame with or without a depth buffer. Without one, the buffer's memory
+    /// is released and nothing is cleared: draws must not use it (a draw that does
+    /// gets a fresh one).
+    pub fn begin_frame_with<C: ColorTarget>(
+        &mut self,
+        target: Target,
+        color: &mut C,
+        background: Vec3,
+        depth: bool,
+    ) {
+        self.target = target;
+        if depth {
+            self.depth.reset(target.width, target.height);
+            counters::add(Stage::DepthClears, target.len() as u64);
+        } else {
+            self.depth = DepthBuffer::empty(target.width, target.height);
+        }
+        color.reset(target.len(), background);
+        self.stats = DrawStats::default();
+    }
+
+    /// Whether this frame has a depth buffer.
+    #[must_use]
+    pub fn has_depth(&self) -> bool {
+        self.depth.has_storage()
+            && (self.depth.width(), self.depth.height()) == (self.target.width, self.target.height)
+    }
+
+    /// Draws indexed triangles whose vertices are already in `cache` (see [`transform`]).
+    pub fn draw<S: Shader, C: ColorTarget>(
+        &mut self,
+        shader: &S,
+        cache: &VertexCache<S::Varying>,
+        indices: &[u32],
+        opts: &DrawOptions,
+        color: &mut C,
+    ) {
+        if opts.depth.uses_buffer() && !self.has_depth() {
+            self.depth.reset(self.target.width, self.target.height);
+        }
+        let copy = self.copy_for::<S>(opts);
+        isa::run(copy, self, shader, cache, indices, opts, color);
+    }
+
+    /// The copy of the draw loop a draw of shader `S` with `opts` runs on this renderer
+    /// (see [`DrawCopy::choose`]).
+    #[must_use]
+    pub fn copy_for<S: Shader>(&self, opts: &DrawOptions) -> DrawCopy {
+        DrawCopy::choose::<S>(self.isa, opts, self.target.width)
+    }
+
+    /// The body of every copy of the draw loop ([`isa`]): projects the vertices once,
+    /// then walks the triangles with variant `V` on lanes `L`.
+    #[inline(always)]
+    fn draw_triangles<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
+        &mut self,
+        shader: &S,
+        cache: &VertexCache<S::Varying>,
+        indices: &[u32],
+        opts: &DrawOptions,
+        color: &mut C,
+    ) {
+        debug_assert!(V::admits(opts), "{opts:?} run on a copy not built for it");
+        let target = self.target;
+        let mut projected = std::mem::take(&mut self.projected);
+        project_vertices(cache, target, &mut projected);
+        let mut walker =
+            PieceWalker::<S, C, L, V>::new(shader, &mut self.depth, color, opts, target);
+        let n = (indices.len() / 3) as u32;
+        for t in 0..n {
+            walker.stats.triangles += 1;
+            let pv = Some(&projected[..]);
+            match prepare_projected(cache, pv, indices, t, target, opts.cull, &mut walker) {
+                PrepareOutcome::Rejected => walker.stats.rejected += 1,
+                PrepareOutcome::Culled => walker.stats.culled += 1,
+                PrepareOutcome::Drawn { clipped } => {
+                    walker.stats.drawn += 1;
+                    walker.stats.clipped += u64::from(clipped);
+                }
+            }
+        }
+        self.stats += walker.stats;
+        self.projected = projected;
+    }
+}

@@ -1,0 +1,302 @@
+//! Per-vertex and per-triangle work: the vertex cache and transform, each vertex's
+//! projection ([`Projected`]), the hand-off to clipping, and the set-up of each piece
+//! into a [`Prepared`] triangle. The renderer and the probe share all of it, so the
+//! probe sees the triangles the renderer drew.
+
+use glam::Vec4;
+
+use super::options::Cull;
+use super::shader::Shader;
+use crate::raster::clip::{
+    ClipOutcome, ClipVertex, classify_codes, clip_straddling, guard_band_ndc, outcode,
+};
+use crate::raster::interp::Varying;
+use crate::raster::setup::snap;
+use crate::raster::{SUBPIXEL_BITS, Setup, Target};
+use crate::simd::each3;
+
+/// A triangle after clipping and projection, ready to rasterize. Vertex arrays are in
+/// setup order (A, B, C after any winding flip).
+#[derive(Clone, Copy, Debug)]
+pub struct Prepared<V> {
+    /// Index of the mesh triangle it came from.
+    pub triangle: u32,
+    /// Which piece of the clipped polygon (0 when unclipped).
+    pub piece: u8,
+    /// Whether clipping cut the original triangle.
+    pub clipped: bool,
+    pub setup: Setup,
+    /// Screen position (pixels) of each vertex before snapping.
+    pub screen: [[f32; 2]; 3],
+    /// NDC depth of each vertex.
+    pub z: [f32; 3],
+    /// 1/w of each vertex.
+    pub inv_w: [f32; 3],
+    /// The varyings in relative form (see [`Varying::relative`]).
+    pub rel: [V; 3],
+    /// For [`Varying::PROJECTIVE`] varyings, the vertex values times `pc`
+    /// ([`Varying::projective_form`]), interpolated with the edge values as weights
+    /// under perspective. Otherwise the vertex values, never read.
+    pub projective: [V; 3],
+    /// `1 / area2`, rounded once to f32: barycentrics are `F · inv_area2`.
+    pub inv_area2: f32,
+    /// Depth per unit of B's and C's edge value: `(z_B − z_A) / area2` and
+    /// `(z_C − z_A) / area2`, so depth is `z_A + F_B·zc[0] + F_C·zc[1]` (two fused
+    /// multiply-adds, exactly `z_A` at A).
+    pub zc: [f32; 2],
+    /// `(1/w_i) / area2` per vertex: the perspective numerators are `F_i · pc[i]`.
+    pub pc: [f32; 3],
+    /// `F0e − 256·G0e` per edge (see [`Setup::reduced_edge`]): the same at every pixel,
+    /// so `F0e = 256·G0e + edge_rem[e]` rebuilds the exact edge value from the lanes of
+    /// the `wide` traversal.
+    pub edge_rem: [f32; 3],
+}
+
+/// Reusable per-draw storage: transformed vertices. Kept by the caller so a steady
+/// viewer allocates nothing per frame.
+#[derive(Debug)]
+pub struct VertexCache<V> {
+    pub(crate) verts: Vec<ClipVertex<V>>,
+}
+
+impl<V> Default for VertexCache<V> {
+    fn default() -> Self {
+        Self { verts: Vec::new() }
+    }
+}
+
+/// Result of preparing one mesh triangle.
+pub enum PrepareOutcome {
+    Rejected,
+    Culled,
+    Drawn { clipped: bool },
+}
+
+/// Transforms every vertex once into the cache.
+pub fn transform<S: Shader>(shader: &S, vertex_count: usize, cache: &mut VertexCache<S::Varying>) {
+    cache.verts.clear();
+    cache.verts.extend((0..vertex_count as u32).map(|i| {
+        let (pos, var) = shader.vertex(i);
+        ClipVertex { pos, var }
+    }));
+}
+
+/// Receives the pieces [`prepare`] makes of a triangle. A trait rather than a closure
+/// so the renderer's per-triangle work inlines into its caller (closures are compiled
+/// on their own, without the caller's target features).
+pub trait EmitPiece<V> {
+    fn piece(&mut self, p: &Prepared<V>);
+}
+
+impl<V, F: FnMut(&Prepared<V>)> EmitPiece<V> for F {
+    #[inline(always)]
+    fn piece(&mut self, p: &Prepared<V>) {
+        self(p);
+    }
+}
+
+/// A vertex's clip outcode and projection, computed once per vertex per draw (most
+/// vertices are shared by about six triangles) and identically for clipped vertices,
+/// so a triangle set up from these is bit for bit the triangle set up from scratch.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Projected {
+    /// See [`outcode`].
+    out: u8,
+    /// Whether both screen coordinates snapped (finite and within the guard band).
+    snapped: bool,
+    inv_w: f32,
+    /// Screen position in pixels, before snapping.
+    screen: [f32; 2],
+    /// NDC depth.
+    z: f32,
+    /// Snapped screen position in subpixels.
+    fixed: [i64; 2],
+}
+
+impl Projected {
+    /// Classifies and projects a clip-space position for a target.
+    #[inline(always)]
+    #[must_use]
+    pub fn of(pos: Vec4, target: Target, guard: [f32; 2]) -> Self {
+        let (fw, fh) = (target.width as f32, target.height as f32);
+        let inv_w = 1.0 / pos.w;
+        let p = pos * inv_w;
+        let screen = [(p.x * 0.5 + 0.5) * fw, (0.5 - p.y * 0.5) * fh];
+        let (sx, sy) = (snap(f64::from(screen[0])), snap(f64::from(screen[1])));
+        Self {
+            out: outcode(pos, guard),
+            snapped: sx.is_some() && sy.is_some(),
+            inv_w,
+            screen,
+            z: pos.z * inv_w,
+            fixed: [sx.unwrap_or(0), sy.unwrap_or(0)],
+        }
+    }
+}
+
+/// Projects every vertex of `cache` for `target` into `out` (reusing its storage).
+pub fn project_vertices<V>(cache: &VertexCache<V>, target: Target, out: &mut Vec<Projected>) {
+    let guard = guard_band_ndc(target.width, target.height);
+    out.clear();
+    out.extend(
+        cache
+            .verts
+            .iter()
+            .map(|v| Projected::of(v.pos, target, guard)),
+    );
+}
+
+/// Clips, projects and sets up mesh triangle `t`, calling `emit` for each piece that
+/// reaches the rasterizer. Shared by the renderer and the probe.
+#[inline(always)]
+pub fn prepare<V: Varying>(
+    cache: &VertexCache<V>,
+    indices: &[u32],
+    t: u32,
+    target: Target,
+    cull: Cull,
+    emit: &mut impl EmitPiece<V>,
+) -> PrepareOutcome {
+    prepare_projected(cache, None, indices, t, target, cull, emit)
+}
+
+/// [`prepare`] with the vertices' projections from [`project_vertices`] (for this
+/// cache and target) when given, else computed here: the result is the same.
+#[inline(always)]
+pub fn prepare_projected<V: Varying>(
+    cache: &VertexCache<V>,
+    projected: Option<&[Projected]>,
+    indices: &[u32],
+    t: u32,
+    target: Target,
+    cull: Cull,
+    emit: &mut impl EmitPiece<V>,
+) -> PrepareOutcome {
+    let base = t as usize * 3;
+    let Some(idx) = indices.get(base..base + 3) else {
+        return PrepareOutcome::Rejected;
+    };
+    let fetch = |i: u32| cache.verts.get(i as usize).copied();
+    let (Some(a), Some(b), Some(c)) = (fetch(idx[0]), fetch(idx[1]), fetch(idx[2])) else {
+        return PrepareOutcome::Rejected;
+    };
+    let tri = [a, b, c];
+    let guard = guard_band_ndc(target.width, target.height);
+    let pv = match projected {
+        Some(p) => match (
+            p.get(idx[0] as usize),
+            p.get(idx[1] as usize),
+            p.get(idx[2] as usize),
+        ) {
+            (Some(&pa), Some(&pb), Some(&pc)) => [pa, pb, pc],
+            _ => return PrepareOutcome::Rejected,
+        },
+        None => each3!(|i| Projected::of(tri[i].pos, target, guard)),
+    };
+    let outcome = classify_codes(each3!(|i| pv[i].out));
+    let clipped = outcome == ClipOutcome::Clipped;
+    let mut seen = Seen::default();
+    match outcome {
+        ClipOutcome::Rejected => return PrepareOutcome::Rejected,
+        ClipOutcome::Inside => {
+            let var = each3!(|i| tri[i].var);
+            seen.add(setup_piece((t, 0, clipped), pv, var, target, cull, emit));
+        }
+        ClipOutcome::Clipped => {
+            let Some(poly) = clip_straddling(tri, guard) else {
+                return PrepareOutcome::Rejected;
+            };
+            for (i, tri) in poly.triangles().enumerate() {
+                let pv = each3!(|i| Projected::of(tri[i].pos, target, guard));
+                let var = each3!(|i| tri[i].var);
+                seen.add(setup_piece((t, i, clipped), pv, var, target, cull, emit));
+            }
+        }
+    }
+    match (seen.drawn, seen.culled) {
+        (true, _) => PrepareOutcome::Drawn { clipped },
+        (false, true) => PrepareOutcome::Culled,
+        (false, false) => PrepareOutcome::Rejected,
+    }
+}
+
+/// What became of a triangle's pieces.
+#[derive(Default)]
+struct Seen {
+    drawn: bool,
+    culled: bool,
+}
+
+impl Seen {
+    /// Notes what became of a piece.
+    #[inline(always)]
+    fn add(&mut self, piece: Piece) {
+        match piece {
+            Piece::Drawn => self.drawn = true,
+            Piece::Culled => self.culled = true,
+            Piece::Rejected => {}
+        }
+    }
+}
+
+/// What became of one piece of a triangle.
+enum Piece {
+    /// Set up and handed to the [`EmitPiece`].
+    Drawn,
+    Culled,
+    Rejected,
+}
+
+/// Sets up one (possibly clipped) triangle whose vertices all have w > 0, from their
+/// projections, and hands it to `emit`. The record is built where `emit` reads it:
+/// returned in an enum and then passed on, it would be partly copied once more.
+#[inline(always)]
+fn setup_piece<V: Varying>(
+    (t, piece, clipped): (u32, usize, bool),
+    pv: [Projected; 3],
+    var: [V; 3],
+    target: Target,
+    cull: Cull,
+    emit: &mut impl EmitPiece<V>,
+) -> Piece {
+    // Not `iter().all(..)`: it stays out of line in the AVX2 draw loop.
+    if !(pv[0].snapped && pv[1].snapped && pv[2].snapped) {
+        return Piece::Rejected;
+    }
+    let Ok(setup) = Setup::from_snapped(each3!(|i| pv[i].fixed), target) else {
+        return Piece::Rejected;
+    };
+    // Counter-clockwise in NDC (y-up) is negative area in y-down screen space.
+    if cull == Cull::Back && !setup.flipped {
+        return Piece::Culled;
+    }
+    let order = |i: usize| if setup.flipped && i > 0 { 3 - i } else { i };
+    let var = each3!(|i| var[order(i)]);
+    // The raw value at the box's origin less 256 times the reduced one.
+    let g = setup.reduced_at_origin();
+    let edge_rem = each3!(|e| (setup.origin[e] - setup.bias[e] - (g[e] << SUBPIXEL_BITS)) as f32);
+    let z = each3!(|i| pv[order(i)].z);
+    let inv_w = each3!(|i| pv[order(i)].inv_w);
+    // In f64, rounded once: the per-pixel terms then carry one rounding each.
+    let ia = 1.0 / setup.area2 as f64;
+    let slope = |i: usize| ((f64::from(z[i]) - f64::from(z[0])) * ia) as f32;
+    let zc = [slope(1), slope(2)];
+    let pc = each3!(|i| (f64::from(inv_w[i]) * ia) as f32);
+    let rel = V::relative(&var[0], &var[1], &var[2]);
+    emit.piece(&Prepared {
+        triangle: t,
+        piece: piece as u8,
+        clipped,
+        setup,
+        screen: each3!(|i| pv[order(i)].screen),
+        z,
+        inv_w,
+        zc,
+        pc,
+        rel,
+        projective: V::projective_form(&var, pc),
+        inv_area2: ia as f32,
+        edge_rem,
+    });
+    Piece::Drawn
+}

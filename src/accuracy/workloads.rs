@@ -266,6 +266,7 @@ pub fn scene(name: &str) -> Option<Scene3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::ndc_to_screen;
 
     #[test]
     fn near_plane_scene_is_clipped_and_floor_is_visible() {
@@ -321,8 +322,7 @@ mod tests {
                 let hit = s.exact_hit(target, x, y).unwrap();
                 assert!(normal.dot(hit - point).abs() < 1e-9);
                 let c = vp * hit.extend(1.0);
-                let sx = (c.x / c.w * 0.5 + 0.5) * 160.0;
-                let sy = (0.5 - c.y / c.w * 0.5) * 120.0;
+                let [sx, sy] = ndc_to_screen([c.x / c.w, c.y / c.w], [160.0, 120.0]);
                 assert!((sx - f64::from(x) - 0.5).abs() < 1e-6, "{sx}");
                 assert!((sy - f64::from(y) - 0.5).abs() < 1e-6, "{sy}");
             }

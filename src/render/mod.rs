@@ -12,10 +12,10 @@
 //! | `isa` | the compiled copies of the draw loop and the one choice among them |
 //! | this file | [`Renderer`]: frame state and the triangle loop |
 //!
-//! Screen mapping: NDC x ∈ [−1, 1] maps to pixels [0, width] left to right, NDC y ∈
-//! [−1, 1] to [height, 0] (screen space is y-down), and z stays NDC z ∈ [0, 1] for
-//! depth. Faces are front-facing when counter-clockwise in NDC (y-up), i.e. when the
-//! rasterizer had to flip them to positive area in y-down screen space.
+//! Screen mapping ([`ndc_to_screen`]): NDC x ∈ [−1, 1] maps to pixels [0, width] left
+//! to right, NDC y ∈ [−1, 1] to [height, 0] (screen space is y-down), and z stays NDC
+//! z ∈ [0, 1] for depth. Faces are front-facing when counter-clockwise in NDC (y-up),
+//! i.e. when the rasterizer had to flip them to positive area in y-down screen space.
 //!
 //! Per-triangle work ([`prepare()`]) and per-pixel work ([`Prepared::eval`]) are shared
 //! by the renderer and the probe, so the probe reports exactly what the renderer did.
@@ -64,8 +64,8 @@ use fragments::PieceWalker;
 pub use isa::{DrawCopy, DrawVariant, Fast, Generic, Isa, Standard, Variant};
 pub use options::{Cull, DrawOptions, DrawStats};
 pub use prepare::{
-    EmitPiece, PrepareOutcome, Prepared, Projected, VertexCache, prepare, prepare_projected,
-    project_vertices, transform,
+    EmitPiece, PrepareOutcome, Prepared, Projected, VertexCache, ndc_to_screen, prepare,
+    prepare_projected, project_vertices, transform,
 };
 pub use shader::{ShadeLanes, Shader};
 pub use target::{ColorTarget, Rgba8};

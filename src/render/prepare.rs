@@ -3,6 +3,8 @@
 //! into a [`Prepared`] triangle. The renderer and the probe share all of it, so the
 //! probe sees the triangles the renderer drew.
 
+use std::ops::{Add, Mul, Sub};
+
 use glam::Vec4;
 
 use super::options::Cull;
@@ -121,7 +123,7 @@ impl Projected {
         let (fw, fh) = (target.width as f32, target.height as f32);
         let inv_w = 1.0 / pos.w;
         let p = pos * inv_w;
-        let screen = [(p.x * 0.5 + 0.5) * fw, (0.5 - p.y * 0.5) * fh];
+        let screen = ndc_to_screen([p.x, p.y], [fw, fh]);
         let (sx, sy) = (snap(f64::from(screen[0])), snap(f64::from(screen[1])));
         Self {
             out: outcode(pos, guard),
@@ -132,6 +134,24 @@ impl Projected {
             fixed: [sx.unwrap_or(0), sy.unwrap_or(0)],
         }
     }
+}
+
+/// Maps NDC `x, y` ∈ [−1, 1] to screen pixels in a target of `size` pixels: x to
+/// `[0, width]` left to right, y to `[height, 0]` (screen space is y-down). The
+/// renderer, the wireframes, the scene outlines and the accuracy references all map
+/// through this, so they agree to the bit (generic so the f64 references use the same
+/// operations).
+#[inline(always)]
+#[must_use]
+pub fn ndc_to_screen<T>(ndc: [T; 2], size: [T; 2]) -> [T; 2]
+where
+    T: Copy + From<f32> + Add<Output = T> + Sub<Output = T> + Mul<Output = T>,
+{
+    let half = T::from(0.5);
+    [
+        (ndc[0] * half + half) * size[0],
+        (half - ndc[1] * half) * size[1],
+    ]
 }
 
 /// Projects every vertex of `cache` for `target` into `out` (reusing its storage).

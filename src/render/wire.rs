@@ -11,7 +11,7 @@
 
 use glam::Vec3;
 
-use super::{ColorTarget, VertexCache};
+use super::{ColorTarget, VertexCache, ndc_to_screen};
 use crate::raster::Target;
 use crate::raster::clip::{clip_segment, guard_band_ndc};
 use crate::raster::depth::DepthBuffer;
@@ -109,9 +109,9 @@ pub fn project_edge<V>(
     let ([p, q], _) = clip_segment(a, b, guard_band_ndc(target.width, target.height))?;
     let screen = |c: glam::Vec4| {
         let n = c / c.w;
-        let x = ((n.x * 0.5 + 0.5) * target.width as f32).floor() as i64;
-        let y = ((0.5 - n.y * 0.5) * target.height as f32).floor() as i64;
-        ((x, y), n.z)
+        let size = [target.width as f32, target.height as f32];
+        let [x, y] = ndc_to_screen([n.x, n.y], size);
+        ((x.floor() as i64, y.floor() as i64), n.z)
     };
     let ((pa, za), (pb, zb)) = (screen(p), screen(q));
     let line = Line::new(pa, pb).ok()?;

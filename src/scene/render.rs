@@ -23,7 +23,7 @@ use crate::render::wire::{
     ScreenLine, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under, project_edge,
 };
 use crate::render::{
-    Cull, DrawOptions, DrawStats, Renderer, Rgba8, Shader, VertexCache, transform,
+    Cull, DrawOptions, DrawStats, Renderer, Rgba8, Shader, VertexCache, ndc_to_screen, transform,
 };
 
 /// Where an object's attributes sit in its packed varyings: the offset of each one
@@ -401,8 +401,7 @@ impl<const K: usize> ObjectPipeline for Pipeline<K> {
             if a.w <= 0.0 || b.w <= 0.0 {
                 continue;
             }
-            let screen =
-                |p: Vec4| Vec2::new((p.x / p.w * 0.5 + 0.5) * w, (0.5 - p.y / p.w * 0.5) * h);
+            let screen = |p: Vec4| Vec2::from(ndc_to_screen([p.x / p.w, p.y / p.w], [w, h]));
             // Hidden silhouettes (behind other surfaces) are left out when depth exists:
             // the midpoint is tested like a wireframe pixel.
             if let Some((d, side)) = depth {

@@ -2,7 +2,7 @@
 //! interpolation and depth, each with an exact reference where one exists.
 //!
 //! 3D scenes reach the 2D variants through the pipeline itself: a scene is projected
-//! and clipped by [`prepare`], and the unsnapped screen positions of every piece become
+//! and clipped by [`prepare()`], and the unsnapped screen positions of every piece become
 //! the 2D workload. Planar scenes carry their plane and texture mapping, so the
 //! attribute at any pixel has an analytic value (the ray through the pixel centre,
 //! intersected with the plane, in f64).

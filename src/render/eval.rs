@@ -2,7 +2,7 @@
 //! edge values, depth, perspective and span weights.
 //!
 //! This file owns the bit-for-bit contract between them. The fragment loop's lanes
-//! ([`super::fragments`]) and the scalar [`Prepared::eval`] (single pixels, the probe)
+//! (`render::fragments`) and the scalar [`Prepared::eval`] (single pixels, the probe)
 //! must perform the same IEEE operations in the same order, so each lane function sits
 //! next to its scalar twin. A multiply-add is fused only where both say `mul_add`.
 //! Change one, change the other; the pipeline and probe tests compare whole frames.

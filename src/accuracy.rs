@@ -6,7 +6,7 @@
 //! | family | variants | reference |
 //! |---|---|---|
 //! | edge arithmetic ([`edge`]) | `f32-direct`, `f32-incremental`, `f64`, `fixed4`, `fixed8`, `i64` | the i128 oracle on the 1/256 px grid |
-//! | traversal | `scalar`, `seed-simd`, `block`, `wide` | the oracle |
+//! | traversal | `scalar`, `planes`, `block`, `wide` | the oracle |
 //! | interpolation | `affine`, `perspective`, `perspective-4/8/16` (the renderer's modes) | ray–plane intersection in f64 |
 //! | anti-aliasing ([`area`]) | `1x`, `4x`, `16x` samples per pixel | exact area of triangle ∩ pixel |
 //! | depth ([`depth`]) | `depth-f32`, `depth-unorm24`, `depth-unorm16`, `depth-f32-reversed` | the known nearer of two close planes |

@@ -8,13 +8,14 @@
 //!   by rounding to nearest (ties away from zero). Everything after snapping is
 //!   integer arithmetic, so coverage is exact: it depends only on the snapped
 //!   vertices, never on evaluation order or traversal.
-//! * **Edge functions** follow seed 000: for the edge A→B,
+//! * **Edge functions** (defined with the other terms in `docs/rasterization.md`): for
+//!   the edge A→B,
 //!   `I01 = Ay − By`, `J01 = Bx − Ax`, `K01 = Ax·By − Ay·Bx`, and
 //!   `F01(P) = I01·Px + J01·Py + K01`; `F02` is B→C and `F03` is C→A. With the doubled
 //!   signed area `area2 = (Bx−Ax)(Cy−Ay) − (By−Ay)(Cx−Ax)` made positive (B and C are
 //!   swapped for the other winding) every `F` is ≥ 0 inside, and `F01 + F02 + F03 = area2`.
 //!   The barycentric weights of A, B, C are `u = F02/area2`, `v = F03/area2`,
-//!   `w = F01/area2` (seed 000 eq. 13–15).
+//!   `w = F01/area2`.
 //! * **Fill rule: top-left** (Direct3D 10+). A centre exactly on an edge belongs to the
 //!   triangle only if that edge is a *left* edge (it goes up, `b.y < a.y`) or a *top*
 //!   edge (horizontal, going right). The other edges get a bias of −1, so the test is
@@ -31,7 +32,7 @@
 //! # Layout
 //!
 //! [`setup`] does everything that depends on the triangle alone; the traversals in
-//! [`traverse`] (`scalar`, `seed_simd`, `block`, `wide`) only walk its pixels and must
+//! [`traverse`] (`scalar`, `planes`, `block`, `wide`) only walk its pixels and must
 //! agree bit for bit. [`oracle`] is an independent i128 reference used by the tests and
 //! the accuracy benchmark.
 
@@ -40,6 +41,7 @@ pub mod depth;
 pub mod interp;
 pub mod line;
 pub mod oracle;
+pub mod samples;
 pub mod setup;
 pub mod sink;
 pub mod traverse;

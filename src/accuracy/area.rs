@@ -6,6 +6,7 @@
 //! covered. The reference is the exact area of the triangle (on the same 1/256 px
 //! grid) inside each pixel square, by polygon clipping in f64.
 
+pub use crate::raster::samples::grid_side;
 use crate::raster::traverse::wide;
 use crate::raster::{CoverageSink, SUBPIXEL_ONE, Setup, Target, snap};
 use crate::workload::Tri2;
@@ -21,16 +22,6 @@ pub fn aa_name(samples: u32) -> &'static str {
         4 => "4x",
         16 => "16x",
         _ => "?x",
-    }
-}
-
-/// Side of the sample grid for a sample count (1, 2 or 4).
-#[must_use]
-pub fn grid_side(samples: u32) -> u32 {
-    match samples {
-        0..=1 => 1,
-        2..=4 => 2,
-        _ => 4,
     }
 }
 

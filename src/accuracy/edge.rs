@@ -5,10 +5,9 @@
 //! traversal); `i64` is the same grid walked by the scalar traversal with 64-bit steps;
 //! `fixed4` snaps vertices to 1/16 px and then runs the exact path, so its only error is
 //! the coarser grid. The float variants get the same snapped vertices and use the
-//! seed's formulation, `F = I·x + J·y + K` with `K = Ax·By − Ay·Bx`, with the top-left
+//! textbook formulation, `F = I·x + J·y + K` with `K = Ax·By − Ay·Bx`, with the top-left
 //! rule applied to exact zeros: `f32-direct` and `f64` evaluate it at every pixel
-//! centre, `f32-incremental` steps it by `I` per pixel and `J` per row as seed 000 §2
-//! does. Their errors are therefore the arithmetic's alone: rounding in `K` far from
+//! centre, `f32-incremental` steps it by `I` per pixel and `J` per row. Their errors are therefore the arithmetic's alone: rounding in `K` far from
 //! the origin and near edges, and drift along long rows. (Direct evaluation is
 //! sign-symmetric on a shared edge, `F_ba = −F_ab` bit for bit, so it cannot crack
 //! there; stepping from each triangle's own origin can.)

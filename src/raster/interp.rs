@@ -1,4 +1,5 @@
-//! Varyings and their interpolation (seed 000 §3–4).
+//! Varyings and their interpolation (barycentric and perspective-correct weights as
+//! `docs/rasterization.md` defines them).
 //!
 //! A draw's varyings are one concrete type chosen at compile time, so the per-pixel
 //! weighted sum is inlined for exactly the attributes the shader uses: a shader with
@@ -6,7 +7,7 @@
 //!
 //! Screen-space barycentrics `(u, v, w)` come from the exact integer edge values
 //! divided by the doubled area (so they are exact up to one rounding and do not lose
-//! precision far from the origin). Perspective-correct weights follow eq. 16–23:
+//! precision far from the origin). Perspective-correct weights
 //! interpolate `1/w` and `attribute/w` linearly and divide once per pixel. A varying
 //! whose shader needs only its direction ([`Direction`], Lambert's normal) skips the
 //! division: `attribute/w` is a positive multiple of the attribute, which the
@@ -19,7 +20,8 @@ pub trait Varying: Copy {
     /// Whether only the value's direction matters to the shader that reads it (a
     /// normal it normalises per pixel): the value times any positive factor shades
     /// the same. Under perspective such a varying is interpolated as `attribute/w`
-    /// itself, eq. 21's numerator `Σ vᵢ·bᵢ/wᵢ`, without eq. 23's division by the
+    /// itself, the numerator `Σ vᵢ·bᵢ/wᵢ` of the perspective-correct form, without its
+    /// division by the
     /// interpolated `1/w`: as `Σ (vᵢ·cᵢ)·Fᵢ` for the exact edge values `Fᵢ`, with
     /// `cᵢ = (1/wᵢ)/area2` folded into the vertex values once per triangle
     /// ([`Varying::projective_form`]). That saves a division and a multiply per
@@ -197,7 +199,7 @@ impl<A: Varying, B: Varying> Varying for (A, B) {
 /// How attributes are interpolated across the screen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Interpolation {
-    /// Weights `b_i/w_i / Σ b_j/w_j` (eq. 23) at every pixel: correct under perspective.
+    /// Weights `b_i/w_i / Σ b_j/w_j` at every pixel: correct under perspective.
     Perspective,
     /// Perspective-correct at every 4th pixel of a row (x a multiple of 4), linear in
     /// between: the classic subdivided span of software renderers.

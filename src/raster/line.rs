@@ -1,11 +1,12 @@
-//! The midpoint (Bresenham) line algorithm of seed 004, in all eight octants, with an
+//! The midpoint (Bresenham) line algorithm (`docs/rasterization.md`), in all eight
+//! octants, with an
 //! optional step-by-step trace and exact clipping.
 //!
 //! # Conventions
 //!
 //! * Endpoints are integer pixels; every pixel between them is drawn, endpoints
 //!   included: `max(|Δx|, |Δy|) + 1` pixels.
-//! * The line is reduced to the seed's first-octant case by reflections: the
+//! * The line is reduced to the first-octant case by reflections: the
 //!   endpoints are swapped so the major axis is walked increasing, x and y are swapped
 //!   for steep lines (|Δy| > |Δx|), and the minor axis is flipped for negative slopes.
 //!   In that frame `dx ≥ dy ≥ 0`, `d₀ = 2dy − dx`, `incrE = 2dy`,
@@ -13,9 +14,9 @@
 //!   coordinate) when `d ≤ 0`, else **NE**. A midpoint exactly on the line (`d = 0`)
 //!   therefore stays on the start's minor coordinate, and A→B draws the same pixels as
 //!   B→A (both walk from the same end).
-//! * The seed's demonstration code swaps x and y but keeps looping over the old x range,
-//!   so steep lines with negative slope never run; here the loop always runs over the
-//!   major axis of the reflected line.
+//! * The loop always runs over the major axis of the reflected line (a common
+//!   mistake swaps x and y but keeps looping over the old x range, so steep lines
+//!   with negative slope never run).
 //! * Closed form (used for clipping): the minor offset at step `k` is
 //!   `y_k = ⌈(2k·dy − dx) / 2dx⌉` and the decision variable before step `k` is
 //!   `d_k = 2dy(k+1) − 2dx·y_k − dx`. A clipped line starts its walk at the first step
@@ -34,7 +35,7 @@ pub enum Move {
 }
 
 impl Move {
-    /// The seed's name.
+    /// The classic name.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {

@@ -118,7 +118,7 @@ impl std::fmt::Display for Reject {
     }
 }
 
-/// Names of the three edge functions, in index order, as seed 000 numbers them.
+/// Names of the three edge functions, in index order (`docs/rasterization.md`).
 pub const EDGE_NAMES: [&str; 3] = ["F01", "F02", "F03"];
 
 /// One triangle ready for traversal.
@@ -242,7 +242,7 @@ impl Setup {
     }
 
     /// Screen-space barycentrics `(u, v, w)` of the caller's vertices A, B, C at a point in
-    /// subpixel units (seed 000 eq. 13–15: `u = F02/area2`, `v = F03/area2`,
+    /// subpixel units (`u = F02/area2`, `v = F03/area2`,
     /// `w = F01/area2`), exact up to the final division.
     #[must_use]
     pub fn barycentric_at_subpixel(&self, px: i64, py: i64) -> [f64; 3] {

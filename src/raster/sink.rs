@@ -1,7 +1,7 @@
 //! Where traversals send coverage.
 //!
 //! A traversal reports covered pixels in the widest form it has: single pixels
-//! (`scalar`, `seed_simd`, partial blocks), fully covered runs (inside blocks) or 8-pixel
+//! (`scalar`, `planes`, partial blocks), fully covered runs (inside blocks) or 8-pixel
 //! masks (`wide`). Sinks are generic parameters, so each traversal is monomorphized
 //! for its sink and nothing is dispatched per pixel.
 

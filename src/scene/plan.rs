@@ -159,7 +159,7 @@ impl Plan {
             },
         ];
         lines.push(if samples > 1 {
-            let side = super::super::accuracy::area::grid_side(samples);
+            let side = crate::raster::samples::grid_side(samples);
             StageLine::new(
                 "supersampling",
                 true,

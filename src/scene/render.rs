@@ -13,10 +13,10 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use super::file::{LightKind, Lighting};
 use super::plan::{ObjectPlan, VaryingSet};
 use super::{LightDesc, Scene, SceneObject};
-use crate::accuracy::area::grid_side;
 use crate::counters::{self, Stage};
 use crate::raster::Target;
 use crate::raster::depth::{DepthBuffer, DepthState};
+use crate::raster::samples::grid_side;
 use crate::render::probe::{Probe, probe_from};
 use crate::render::standard::WIRE_COLOR;
 use crate::render::wire::{

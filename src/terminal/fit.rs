@@ -309,7 +309,7 @@ fn dot3<F: F32s>(a: [F; 3], b: [F; 3]) -> F {
 #[must_use]
 pub fn fit_lanes<'r>(rep: &'r Repertoire, x: &[[[f32; 8]; 3]; N]) -> [Fit<'r>; 8] {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if crate::simd::Isa::Avx2.is_supported() {
         // SAFETY: the CPU has the features the function is compiled for.
         return unsafe { fit_lanes_avx2(rep, x) };
     }

@@ -277,7 +277,7 @@ impl App {
         let (px, py) = sl.line.pixel(f.k, sl.line.minor_at(f.k));
         // A scene's line is in its supersampled grid.
         let side = self.scene.as_ref().map_or(1, |s| {
-            i64::from(crate::accuracy::area::grid_side(s.scene.plan.samples))
+            i64::from(crate::raster::samples::grid_side(s.scene.plan.samples))
         });
         let (px, py) = (px.div_euclid(side), py.div_euclid(side));
         let (sx, sy) = self.settings.glyphs.dims();

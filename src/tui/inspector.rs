@@ -1,9 +1,9 @@
 //! The inspector and line panels: the raster state of one cell, from the probe, in
-//! the seed notes' names (F01, F02, F03, u, v, w, depth, octant, dx, dy, incrE,
+//! the names `docs/rasterization.md` defines (F01, F02, F03, u, v, w, depth, octant, dx, dy, incrE,
 //! incrNE, d).
 
-use crate::accuracy::area::grid_side;
 use crate::raster::line::Move;
+use crate::raster::samples::grid_side;
 use crate::render::Shader;
 use crate::render::probe::{DepthOutcome, Probe, probe};
 use crate::render::standard::{Model, StandardFrame};

@@ -52,7 +52,7 @@ fn every_variant_is_measured_and_exact_ones_are_exact() {
     );
     assert_eq!(
         names(Family::Traversal),
-        ["scalar", "seed-simd", "block", "wide"]
+        ["scalar", "planes", "block", "wide"]
     );
     assert_eq!(
         names(Family::Interpolation),

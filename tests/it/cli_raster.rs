@@ -31,7 +31,7 @@ fn raster(args: &[&str], stdin: &str) -> (bool, String, String) {
 #[test]
 fn grid_of_the_split_square() {
     let input = "0 0 5 0 5 5\n# comment\n\n0 0 5 5 0 5\n";
-    for t in ["scalar", "seed-simd", "block", "wide"] {
+    for t in ["scalar", "planes", "block", "wide"] {
         let (ok, out, err) = raster(
             &["--size", "6x6", "--traversal", t, "--format", "counts"],
             input,
@@ -171,7 +171,7 @@ fn termrast(args: &[&str]) -> (bool, String, String) {
 }
 
 #[test]
-fn line_command_traces_the_seed_example() {
+fn line_command_traces_the_worked_example() {
     let (ok, out, err) = termrast(&["line", "5", "8", "9", "11", "--trace", "--format", "cells"]);
     assert!(ok, "{err}");
     assert!(out.contains("dx=4 dy=3 incrE=6 incrNE=-2 d0=2"), "{out}");

@@ -3,7 +3,7 @@
 
 use crate::common::{accumulate, assert_all_match_oracle, coverage, oracle_grid};
 use proptest::prelude::*;
-use termrast::raster::traverse::seed_simd_lanes;
+use termrast::raster::traverse::planes_lanes;
 use termrast::raster::{CountGrid, Setup, Target, Traversal};
 
 const T: Target = Target {
@@ -12,8 +12,8 @@ const T: Target = Target {
 };
 
 #[test]
-fn seed_001_barycentrics() {
-    // P=(10,20), Q=(70,30), R=(60,80), p=(55,43) → (0.2, 0.5, 0.3) (seed 001).
+fn worked_example_barycentrics() {
+    // P=(10,20), Q=(70,30), R=(60,80), p=(55,43) → (0.2, 0.5, 0.3), the classic worked example.
     let s = Setup::new(
         [[10.0, 20.0], [70.0, 30.0], [60.0, 80.0]],
         Target::new(128, 128),
@@ -206,7 +206,7 @@ proptest! {
 }
 
 #[test]
-fn seed_lanes_give_one_over_z_and_barycentrics() {
+fn plane_lanes_give_one_over_z_and_barycentrics() {
     // Lane 0 is the 1/z plane: at each covered pixel, (1/z, w, u, v) from the lanes
     // equals the perspective formula evaluated from the exact barycentrics.
     let target = Target::new(64, 64);
@@ -214,7 +214,7 @@ fn seed_lanes_give_one_over_z_and_barycentrics() {
     let zinv = [1.0, 0.25, 0.1];
     let s = Setup::new(tri, target).unwrap();
     let mut n = 0;
-    seed_simd_lanes(&s, zinv, |x, y, lanes| {
+    planes_lanes(&s, zinv, |x, y, lanes| {
         let [iz, w, u, v] = lanes.normalized();
         let px = i64::from(x) * 256 + 128;
         let py = i64::from(y) * 256 + 128;

@@ -1,4 +1,4 @@
-//! Midpoint lines: seed 004's examples, all octants, symmetry, an exact reference,
+//! Midpoint lines: the classic worked examples, all octants, symmetry, an exact reference,
 //! clipping and connectivity.
 
 use proptest::prelude::*;
@@ -26,7 +26,7 @@ fn decisions(steps: &[Step]) -> Vec<(i64, Move)> {
 }
 
 #[test]
-fn seed_004_worked_example() {
+fn worked_example() {
     // (5,8)→(9,11): d = 2 → NE, 0 → E, 6 → NE, 4 → NE.
     let steps = trace((5, 8), (9, 11));
     assert_eq!(
@@ -42,7 +42,7 @@ fn seed_004_worked_example() {
 }
 
 #[test]
-fn seed_004_other_cases() {
+fn other_worked_cases() {
     // −1 < m < 0: flipped about the x axis; ties (d = 0) stay on the start's row.
     assert_eq!(
         pixels((0, 4), (4, 2)),
@@ -57,7 +57,7 @@ fn seed_004_other_cases() {
         pixels((1, 2), (3, 6)),
         vec![(1, 2), (1, 3), (2, 4), (2, 5), (3, 6)]
     );
-    // Steep with negative slope, the case the seed's demonstration never runs.
+    // Steep with negative slope, the case a common mistake never runs.
     assert_eq!(
         pixels((3, 2), (1, 6)),
         vec![(3, 2), (3, 3), (2, 4), (2, 5), (1, 6)]

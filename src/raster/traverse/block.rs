@@ -1,3 +1,4 @@
+use super::scalar::walk_rect;
 use crate::raster::{CoverageSink, PixelRect, Setup};
 
 /// Default block side q.
@@ -30,8 +31,9 @@ impl BlockClass {
 /// Classifies a block from the biased edge values at its four corner pixel centres,
 /// `corners[e] = [top-left, top-right, bottom-left, bottom-right]` of edge `e`.
 ///
-/// Seed 002 gets two things wrong here: a block is inside only if it is inside *all*
-/// three edges (not any), and it is outside as soon as *one* edge rejects all corners.
+/// A block is inside only if all four corners pass *all* three edges, and outside as
+/// soon as *one* edge rejects all four corners (a common mistake has these the other
+/// way round).
 #[must_use]
 #[inline]
 pub fn classify_corners(corners: [[i64; 4]; 3]) -> BlockClass {
@@ -87,9 +89,8 @@ pub fn classify_block(s: &Setup, r: PixelRect) -> BlockClass {
     }))
 }
 
-/// Seed 002 with its errors fixed: q×q blocks with trivial reject and accept. Block
-/// corners are stepped incrementally by `q·I` and `q·J`; partial blocks fall back to
-/// the scalar per-pixel loop inside the block.
+/// q×q blocks with trivial reject and accept. Block corners are stepped incrementally
+/// by `q·I` and `q·J`; partial blocks run the scalar per-pixel walk inside the block.
 pub fn block<S: CoverageSink>(s: &Setup, q: u32, sink: &mut S) {
     let q = q.max(1);
     let b = s.bbox;
@@ -118,21 +119,13 @@ pub fn block<S: CoverageSink>(s: &Setup, q: u32, sink: &mut S) {
                     }
                 }
                 BlockClass::Partial => {
-                    let mut cy = c;
-                    for y in by..=by1 {
-                        let mut cx = cy;
-                        for x in bx..=bx1 {
-                            if cx[0] >= 0 && cx[1] >= 0 && cx[2] >= 0 {
-                                sink.pixel(x, y);
-                            }
-                            for e in 0..3 {
-                                cx[e] += sx[e];
-                            }
-                        }
-                        for e in 0..3 {
-                            cy[e] += sy[e];
-                        }
-                    }
+                    let r = PixelRect {
+                        x0: bx,
+                        y0: by,
+                        x1: bx1,
+                        y1: by1,
+                    };
+                    walk_rect(r, c, sx, sy, sink);
                 }
             }
             for e in 0..3 {

@@ -5,15 +5,15 @@ use crate::raster::{CoverageSink, Setup};
 /// Largest number of fractional bits given to lane 0 (the 1/z plane).
 const MAX_ZINV_BITS: u32 = 30;
 
-/// The seed's 4-lane state at one pixel: `(F00, F01, F02, F03)`.
+/// The four planes at one pixel: `(F00, F01, F02, F03)` (see `docs/rasterization.md`).
 ///
 /// Lanes 1–3 are the biased edge functions (the coverage test is lanes 1–3 ≥ 0).
-/// Lane 0 is the 1/z plane of seed 000 eq. 18–22, `F00 = F02/zA + F03/zB + F01/zC`,
+/// Lane 0 is the 1/z plane, `F00 = F02/zA + F03/zB + F01/zC = area2/z`,
 /// held in fixed point so the whole vector steps by exact integer adds: each vertex's
 /// 1/z is quantized to `zinv_bits` fractional bits relative to the largest one, with
 /// `zinv_bits` chosen per triangle as large as the bounding box allows without overflow.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SeedLanes {
+pub struct PlaneLanes {
     /// Raw lane values.
     pub f: [i64; 4],
     /// Fill-rule bias in lanes 1–3, subtracted back for barycentrics.
@@ -24,8 +24,8 @@ pub struct SeedLanes {
     pub zinv_unit: f64,
 }
 
-impl SeedLanes {
-    /// The lanes divided by the doubled area: `(1/z, w, u, v)` as seed 000 §4 names them,
+impl PlaneLanes {
+    /// The lanes divided by the doubled area: `(1/z, w, u, v)`,
     /// with `u, v, w` the weights of A, B, C.
     #[must_use]
     pub fn normalized(&self) -> [f64; 4] {
@@ -42,7 +42,7 @@ impl SeedLanes {
 /// Seed 000 §4: one `i64x4` per pixel, stepped by the vectors `I` and `J`, calling
 /// `visit(x, y, lanes)` for each covered pixel. `zinv` holds 1/z of the caller's
 /// vertices A, B, C (in the order given to [`Setup::new`]).
-pub fn seed_simd_lanes<V: FnMut(u32, u32, &SeedLanes)>(s: &Setup, zinv: [f64; 3], mut visit: V) {
+pub fn planes_lanes<V: FnMut(u32, u32, &PlaneLanes)>(s: &Setup, zinv: [f64; 3], mut visit: V) {
     let b = s.bbox;
     let zinv = s.unflip(zinv);
     let (x0, y0) = (i64::from(b.x0), i64::from(b.y0));
@@ -77,7 +77,7 @@ pub fn seed_simd_lanes<V: FnMut(u32, u32, &SeedLanes)>(s: &Setup, zinv: [f64; 3]
     let step_i = i64x4::new([lane0(sx), sx[0], sx[1], sx[2]]);
     let step_j = i64x4::new([lane0(sy), sy[0], sy[1], sy[2]]);
     let mut cy = i64x4::new([lane0(f0_raw), f0[0], f0[1], f0[2]]);
-    let mut lanes = SeedLanes {
+    let mut lanes = PlaneLanes {
         f: [0; 4],
         bias: s.bias,
         area2: s.area2,
@@ -98,7 +98,7 @@ pub fn seed_simd_lanes<V: FnMut(u32, u32, &SeedLanes)>(s: &Setup, zinv: [f64; 3]
     }
 }
 
-/// Coverage through the seed's 4-lane layout (lane 0 carries a constant 1/z).
-pub fn seed_simd<S: CoverageSink>(s: &Setup, sink: &mut S) {
-    seed_simd_lanes(s, [1.0; 3], |x, y, _| sink.pixel(x, y));
+/// Coverage through the 4-lane plane layout (lane 0 carries a constant 1/z).
+pub fn planes<S: CoverageSink>(s: &Setup, sink: &mut S) {
+    planes_lanes(s, [1.0; 3], |x, y, _| sink.pixel(x, y));
 }

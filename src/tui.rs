@@ -245,7 +245,8 @@ pub fn run(mut app: App, options: RunOptions) -> Result<(), ViewError> {
         &bytes,
     );
     LEAVING.store(RESTORING, Ordering::Release);
-    settle(&wakes, &mut parser, &mut pacer);
+    // Leaving anyway: whatever arrives meanwhile changes nothing.
+    let _ = settle(&wakes, &mut parser, &mut pacer);
     drop(terminal);
     drop(guard);
     LEAVING.store(RESTORED, Ordering::Release);
@@ -253,13 +254,16 @@ pub fn run(mut app: App, options: RunOptions) -> Result<(), ViewError> {
 }
 
 /// Before the terminal leaves raw mode, waits a little for the answers to queries
-/// still on their way, so they reach the viewer and not the shell after it.
-fn settle(wakes: &mpsc::Receiver<Wake>, parser: &mut Parser, pacer: &mut Pacer) {
+/// still on their way, so they reach the viewer and not the shell after it. Returns
+/// what ends the viewer if it arrives meanwhile (an ending signal, end of input).
+fn settle(
+    wakes: &mpsc::Receiver<Wake>,
+    parser: &mut Parser,
+    pacer: &mut Pacer,
+) -> Option<ViewError> {
     let until = Instant::now() + Duration::from_millis(300);
     while pacer.in_flight() > 0 {
-        let Some(left) = until.checked_duration_since(Instant::now()) else {
-            return;
-        };
+        let left = until.checked_duration_since(Instant::now())?;
         match wakes.recv_timeout(left) {
             Ok(Wake::Bytes(b)) => {
                 let now = Instant::now();
@@ -270,10 +274,17 @@ fn settle(wakes: &mpsc::Receiver<Wake>, parser: &mut Parser, pacer: &mut Pacer) 
                     }
                 }
             }
+            Ok(Wake::Signal(sig)) if ENDING.contains(&sig) => {
+                return Some(ViewError::Signal(sig));
+            }
             Ok(Wake::Signal(_)) => {}
-            Ok(Wake::Eof) | Err(_) => return,
+            Ok(Wake::Eof) | Err(mpsc::RecvTimeoutError::Disconnected) => {
+                return Some(ViewError::Gone);
+            }
+            Err(mpsc::RecvTimeoutError::Timeout) => return None,
         }
     }
+    None
 }
 
 type Term = Terminal<link::LinkBackend<Counting<Stdout>>>;
@@ -309,11 +320,20 @@ fn draw(
     Ok(())
 }
 
-/// Ctrl-Z: restores the terminal, stops, and on resuming takes it again.
-fn suspend(terminal: &mut Term, pacer: &mut Pacer) -> io::Result<()> {
+/// Ctrl-Z: restores the terminal, stops, and on resuming takes it again. Answers to
+/// queries still on their way are waited for first, so they reach the viewer and not
+/// the shell that takes the terminal over.
+fn suspend(
+    terminal: &mut Term,
+    (wakes, parser): (&mpsc::Receiver<Wake>, &mut Parser),
+    pacer: &mut Pacer,
+) -> Result<(), ViewError> {
+    if let Some(end) = settle(wakes, parser, pacer) {
+        return Err(end);
+    }
     restore();
     signal_hook::low_level::raise(signal_hook::consts::SIGSTOP)?;
-    resume(terminal, pacer)
+    Ok(resume(terminal, pacer)?)
 }
 
 fn resume(terminal: &mut Term, pacer: &mut Pacer) -> io::Result<()> {
@@ -384,7 +404,7 @@ fn main_loop(
                 return Err(ViewError::Signal(sig));
             }
             Some(Wake::Signal(signal_hook::consts::SIGTSTP)) => {
-                suspend(terminal, pacer)?;
+                suspend(terminal, (wakes, parser), pacer)?;
                 resumed = true;
                 dirty = true;
             }
@@ -402,7 +422,7 @@ fn main_loop(
             match input {
                 Input::DeviceAttributes => pacer.answered(now),
                 Input::Event(e) if e == ctrl_z => {
-                    suspend(terminal, pacer)?;
+                    suspend(terminal, (wakes, parser), pacer)?;
                     resumed = true;
                     dirty = true;
                 }

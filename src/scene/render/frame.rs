@@ -1,0 +1,278 @@
+//! A scene's frame: the camera, the buffers the plan asks for, every object drawn in
+//! order, supersampling resolved.
+
+use glam::{Mat3, Vec3};
+
+use super::*;
+use crate::counters::{self, Stage};
+use crate::raster::Target;
+use crate::raster::samples::grid_side;
+use crate::render::probe::Probe;
+use crate::render::wire::{ScreenLine, WireCount};
+use crate::render::{DrawStats, Renderer, Rgba8};
+use crate::scene::Scene;
+use crate::scene::plan::VaryingSet;
+
+/// Where a scene is seen from in one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneView {
+    /// Seconds since the start (spins).
+    pub time: f32,
+    /// Orbit of the camera about its target: radians about y, then about x.
+    pub yaw: f32,
+    pub pitch: f32,
+    /// Camera distance divisor (1 = as in the file).
+    pub zoom: f32,
+    /// Pixel width over height of the target's samples.
+    pub pixel_aspect: f32,
+}
+
+impl Default for SceneView {
+    fn default() -> Self {
+        Self {
+            time: 0.0,
+            yaw: 0.0,
+            pitch: 0.0,
+            zoom: 1.0,
+            pixel_aspect: 1.0,
+        }
+    }
+}
+
+/// Buffers and pipelines for drawing a scene; reused from frame to frame.
+pub struct SceneFrame {
+    pub renderer: Renderer,
+    /// The frame at the requested size (alpha 255 where covered).
+    pub color: Rgba8,
+    /// The supersampled frame (empty when the plan has no supersampling).
+    fine: Rgba8,
+    pipelines: Vec<Box<dyn ObjectPipeline>>,
+    pub silhouettes: Vec<Silhouette>,
+    /// Counters of the last frame, all objects.
+    pub stats: DrawStats,
+    pub wire: WireCount,
+}
+
+impl std::fmt::Debug for SceneFrame {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneFrame")
+            .field("stats", &self.stats)
+            .finish_non_exhaustive()
+    }
+}
+
+impl SceneFrame {
+    /// Pipelines for a scene's objects, by its plan.
+    #[must_use]
+    pub fn new(scene: &Scene) -> Self {
+        Self {
+            renderer: Renderer::new(Target::new(1, 1)),
+            color: Rgba8::default(),
+            fine: Rgba8::default(),
+            pipelines: scene
+                .plan
+                .objects
+                .iter()
+                .map(|o| pipeline_for(o.varyings))
+                .collect(),
+            silhouettes: Vec::new(),
+            stats: DrawStats::default(),
+            wire: WireCount::default(),
+        }
+    }
+
+    /// The varying sets the pipelines were compiled for, per object.
+    #[must_use]
+    pub fn varyings(&self) -> Vec<VaryingSet> {
+        self.pipelines.iter().map(|p| p.varyings()).collect()
+    }
+
+    /// Draws a frame of `target` samples.
+    pub fn draw(&mut self, scene: &Scene, target: Target, view: &SceneView) {
+        let plan = &scene.plan;
+        let side = grid_side(plan.samples);
+        let fine = Target::new(target.width * side, target.height * side);
+        let cam = &scene.camera;
+        let orbit = Mat3::from_rotation_y(view.yaw) * Mat3::from_rotation_x(view.pitch);
+        let eye = cam.target + orbit * (cam.eye - cam.target) / view.zoom.max(0.05);
+        let camera = crate::camera::Camera {
+            eye,
+            up: orbit * cam.up,
+            ..*cam
+        };
+        let view_proj =
+            camera.projection(fine.width, fine.height, view.pixel_aspect) * camera.view();
+        let forward = (cam.target - eye).normalize_or_zero();
+        // Depth shading spans the objects' bounding spheres along the view.
+        let depth_range = scene
+            .objects
+            .iter()
+            .map(|o| {
+                let c = o.desc.model_matrix(view.time).transform_point3(Vec3::ZERO);
+                let r = o.desc.scale * 3f32.sqrt();
+                let d = (c - eye).dot(forward);
+                (d - r, d + r)
+            })
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |a, b| {
+                (a.0.min(b.0), a.1.max(b.1))
+            });
+        let depth_range = if depth_range.0.is_finite() {
+            (
+                depth_range.0.max(cam.near),
+                depth_range.1.max(cam.near + 1e-3),
+            )
+        } else {
+            (cam.near, cam.far)
+        };
+        let ctx = FrameCtx {
+            view_proj,
+            eye,
+            forward,
+            lights: &scene.lights,
+            depth_range,
+            time: view.time,
+        };
+        let color = if side > 1 {
+            &mut self.fine
+        } else {
+            &mut self.color
+        };
+        self.renderer
+            .begin_frame_with(fine, color, scene.background, plan.depth_buffer);
+        let mut stats = DrawStats::default();
+        for ((obj, op), pipe) in scene
+            .objects
+            .iter()
+            .zip(&plan.objects)
+            .zip(&mut self.pipelines)
+        {
+            pipe.draw(obj, op, ctx, &mut self.renderer, color);
+            stats += self.renderer.stats;
+            self.renderer.stats = DrawStats::default();
+        }
+        self.wire = WireCount::default();
+        for ((obj, op), pipe) in scene.objects.iter().zip(&plan.objects).zip(&self.pipelines) {
+            if op.wireframe {
+                let depth = op.hidden_lines.then_some(&self.renderer.depth);
+                self.wire += pipe.wireframe(obj, fine, depth, color);
+            }
+        }
+        self.silhouettes.clear();
+        for ((obj, op), pipe) in scene.objects.iter().zip(&plan.objects).zip(&self.pipelines) {
+            if op.silhouette {
+                let depth = op.depth_test.then_some((&self.renderer.depth, side));
+                pipe.silhouettes(obj, target, depth, &mut self.silhouettes);
+            }
+        }
+        if side > 1 {
+            resolve(
+                &self.fine,
+                fine,
+                side,
+                &mut self.color,
+                target,
+                scene.background,
+            );
+        }
+        self.stats = stats;
+    }
+
+    /// Probes sample `(x, y)` of the last frame (without supersampling) for every
+    /// object in draw order, the depth carried from one object to the next.
+    #[must_use]
+    pub fn probe(&self, scene: &Scene, x: u32, y: u32) -> Vec<Probe<()>> {
+        let mut stored = crate::raster::depth::DEPTH_CLEAR;
+        let mut out = Vec::new();
+        for ((obj, op), pipe) in scene
+            .objects
+            .iter()
+            .zip(&scene.plan.objects)
+            .zip(&self.pipelines)
+        {
+            let p = pipe.probe(obj, op, self.renderer.target, x, y, stored);
+            stored = p.final_depth;
+            out.push(p);
+        }
+        out
+    }
+
+    /// The line under pixel `(x, y)` of the frame's (supersampled) target: of the
+    /// object seen there, a drawn wireframe line through the pixel or the nearest edge
+    /// of its triangle. Returns the object's index, the edge, its screen line and step.
+    #[must_use]
+    pub fn line_under(
+        &self,
+        scene: &Scene,
+        x: u32,
+        y: u32,
+    ) -> Option<(usize, [u32; 2], ScreenLine, i64)> {
+        let probes = self.probe(scene, x, y);
+        let seen = probes.iter().rposition(|p| p.winner.is_some());
+        let depth = self.renderer.has_depth().then_some(&self.renderer.depth);
+        // The object seen there first; else any drawn wireframe through the pixel.
+        let order = seen.into_iter().chain(
+            (0..scene.objects.len())
+                .filter(|&i| Some(i) != seen && scene.plan.objects[i].wireframe),
+        );
+        for i in order {
+            let op = &scene.plan.objects[i];
+            let triangle = probes[i].winner.map(|w| probes[i].records[w].triangle);
+            let wires = op.wireframe.then(|| depth.filter(|_| op.hidden_lines));
+            let found = self.pipelines[i].line_under(
+                &scene.objects[i],
+                wires,
+                triangle,
+                self.renderer.target,
+                x,
+                y,
+            );
+            if let Some((e, sl, k)) = found {
+                return Some((i, e, sl, k));
+            }
+        }
+        None
+    }
+
+    /// Edge `edge` of object `object` projected to the frame's (supersampled) target.
+    #[must_use]
+    pub fn project_edge(&self, object: usize, edge: [u32; 2]) -> Option<ScreenLine> {
+        self.pipelines
+            .get(object)?
+            .project_edge(edge, self.renderer.target)
+    }
+}
+
+/// Averages `side × side` blocks of `fine` into `out`: colour is the mean of the
+/// covered samples blended with the background by coverage, alpha is the coverage.
+fn resolve(fine: &Rgba8, ft: Target, side: u32, out: &mut Rgba8, target: Target, background: Vec3) {
+    let n = side * side;
+    let bg = background
+        .to_array()
+        .map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u32);
+    out.0.clear();
+    out.0.resize(target.len(), [0; 4]);
+    counters::add(Stage::Resolves, target.len() as u64);
+    for y in 0..target.height {
+        for x in 0..target.width {
+            let mut sum = [0u32; 3];
+            let mut covered = 0u32;
+            for j in 0..side {
+                let row = ((y * side + j) * ft.width + x * side) as usize;
+                for p in &fine.0[row..row + side as usize] {
+                    if p[3] == 255 {
+                        covered += 1;
+                        for c in 0..3 {
+                            sum[c] += u32::from(p[c]);
+                        }
+                    }
+                }
+            }
+            let px = &mut out.0[(y * target.width + x) as usize];
+            for c in 0..3 {
+                // Covered samples carry their colour, the others the background.
+                px[c] = ((sum[c] + bg[c] * (n - covered) + n / 2) / n) as u8;
+            }
+            px[3] = ((covered * 255 + n / 2) / n) as u8;
+        }
+    }
+}

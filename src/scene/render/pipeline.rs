@@ -1,0 +1,272 @@
+//! One object's pipeline: its shader compiled for the narrowest packed width that
+//! holds its varyings, its vertex cache, and what it draws (fill, wireframe,
+//! silhouettes, the probe).
+
+use glam::{Vec2, Vec4};
+
+use super::*;
+use crate::counters::{self, Stage};
+use crate::raster::Target;
+use crate::raster::depth::{DepthBuffer, DepthState};
+use crate::render::probe::{Probe, probe_from};
+use crate::render::standard::WIRE_COLOR;
+use crate::render::wire::{
+    ScreenLine, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under, project_edge,
+};
+use crate::render::{Cull, DrawOptions, Renderer, Rgba8, VertexCache, ndc_to_screen, transform};
+use crate::scene::SceneObject;
+use crate::scene::plan::{ObjectPlan, VaryingSet};
+
+/// A silhouette edge on screen, in sample coordinates (pixel centres at +0.5).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Silhouette {
+    pub a: Vec2,
+    pub b: Vec2,
+}
+
+/// One object's pipeline: its monomorphized shader and its vertex cache.
+pub trait ObjectPipeline {
+    /// Transforms and draws the object.
+    fn draw(
+        &mut self,
+        obj: &SceneObject,
+        plan: &ObjectPlan,
+        ctx: FrameCtx<'_>,
+        r: &mut Renderer,
+        color: &mut Rgba8,
+    );
+    /// Draws the object's edges.
+    fn wireframe(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<&DepthBuffer>,
+        color: &mut Rgba8,
+    ) -> WireCount;
+    /// Appends the object's silhouette edges, in the coordinates of `target`.
+    fn silhouettes(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<(&DepthBuffer, u32)>,
+        out: &mut Vec<Silhouette>,
+    );
+    /// The raster state of a pixel for this object, continuing from `stored` depth.
+    fn probe(
+        &self,
+        obj: &SceneObject,
+        plan: &ObjectPlan,
+        target: Target,
+        x: u32,
+        y: u32,
+        stored: f32,
+    ) -> Probe<()>;
+    /// The varying set this pipeline was compiled for.
+    fn varyings(&self) -> VaryingSet;
+    /// The line under a pixel (see [`line_under`]), from this frame's vertices.
+    fn line_under(
+        &self,
+        obj: &SceneObject,
+        wires: Option<Option<&DepthBuffer>>,
+        triangle: Option<u32>,
+        target: Target,
+        x: u32,
+        y: u32,
+    ) -> Option<([u32; 2], ScreenLine, i64)>;
+    /// One of the object's edges projected to `target`, from this frame's vertices.
+    fn project_edge(&self, edge: [u32; 2], target: Target) -> Option<ScreenLine>;
+}
+
+/// The draw options an object's plan asks for.
+#[must_use]
+pub fn draw_options(plan: &ObjectPlan) -> DrawOptions {
+    DrawOptions {
+        depth: if plan.depth_test {
+            DepthState::default()
+        } else {
+            DepthState::OFF
+        },
+        cull: if plan.cull { Cull::Back } else { Cull::None },
+        ..DrawOptions::default()
+    }
+}
+
+/// The pipeline of objects whose varyings fit `K` floats.
+struct Pipeline<const K: usize> {
+    cache: VertexCache<[f32; K]>,
+    varyings: VaryingSet,
+}
+
+impl<const K: usize> ObjectPipeline for Pipeline<K> {
+    fn draw(
+        &mut self,
+        obj: &SceneObject,
+        plan: &ObjectPlan,
+        ctx: FrameCtx<'_>,
+        r: &mut Renderer,
+        color: &mut Rgba8,
+    ) {
+        let shader = ObjectShader::<K>::new(obj, plan, ctx);
+        transform(&shader, obj.mesh.positions.len(), &mut self.cache);
+        r.draw(
+            &shader,
+            &self.cache,
+            &obj.mesh.indices,
+            &draw_options(plan),
+            color,
+        );
+    }
+
+    fn wireframe(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<&DepthBuffer>,
+        color: &mut Rgba8,
+    ) -> WireCount {
+        counters::add(Stage::WireEdges, obj.edges.len() as u64);
+        draw_wireframe(&self.cache, &obj.edges, target, depth, WIRE_COLOR, color)
+    }
+
+    fn silhouettes(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<(&DepthBuffer, u32)>,
+        out: &mut Vec<Silhouette>,
+    ) {
+        let verts = &self.cache.verts;
+        let idx = &obj.mesh.indices;
+        // Facing of a triangle: the sign of its doubled area in NDC (w > 0 only).
+        let facing = |t: u32| -> Option<bool> {
+            let tri = idx.get(t as usize * 3..t as usize * 3 + 3)?;
+            let p = [tri[0], tri[1], tri[2]].map(|i| verts.get(i as usize).map(|v| v.pos));
+            let [Some(a), Some(b), Some(c)] = p else {
+                return None;
+            };
+            if a.w <= 0.0 || b.w <= 0.0 || c.w <= 0.0 {
+                return None;
+            }
+            let (a, b, c) = (a.truncate() / a.w, b.truncate() / b.w, c.truncate() / c.w);
+            Some((b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x) > 0.0)
+        };
+        let (w, h) = (target.width as f32, target.height as f32);
+        for (e, faces) in obj.edges.iter().zip(&obj.edge_faces) {
+            let front = facing(faces[0]);
+            let other = if faces[1] == u32::MAX {
+                None
+            } else {
+                facing(faces[1])
+            };
+            let silhouette = match (front, other) {
+                (Some(a), Some(b)) => a != b,
+                (Some(a), None) => a, // a boundary edge of a front face
+                _ => false,
+            };
+            if !silhouette {
+                continue;
+            }
+            let (Some(a), Some(b)) = (verts.get(e[0] as usize), verts.get(e[1] as usize)) else {
+                continue;
+            };
+            let (a, b) = (a.pos, b.pos);
+            if a.w <= 0.0 || b.w <= 0.0 {
+                continue;
+            }
+            let screen = |p: Vec4| Vec2::from(ndc_to_screen([p.x / p.w, p.y / p.w], [w, h]));
+            // Hidden silhouettes (behind other surfaces) are left out when depth exists:
+            // the midpoint is tested like a wireframe pixel.
+            if let Some((d, side)) = depth {
+                let m = (a + b) * 0.5;
+                let s = screen(m);
+                let (x, y) = ((s.x * side as f32) as u32, (s.y * side as f32) as u32);
+                if x < d.width() && y < d.height() {
+                    let z = m.z / m.w;
+                    if z - WIRE_DEPTH_BIAS * 10.0 > d.get(x, y) {
+                        continue;
+                    }
+                }
+            }
+            counters::add(Stage::SilhouetteEdges, 1);
+            out.push(Silhouette {
+                a: screen(a),
+                b: screen(b),
+            });
+        }
+    }
+
+    fn probe(
+        &self,
+        obj: &SceneObject,
+        plan: &ObjectPlan,
+        target: Target,
+        x: u32,
+        y: u32,
+        stored: f32,
+    ) -> Probe<()> {
+        // The trait object cannot return this pipeline's varying type: the records keep
+        // everything else.
+        let p = probe_from(
+            &self.cache,
+            &obj.mesh.indices,
+            target,
+            &draw_options(plan),
+            x,
+            y,
+            stored,
+        );
+        Probe {
+            x: p.x,
+            y: p.y,
+            records: p.records.into_iter().map(|r| r.map(|_| ())).collect(),
+            winner: p.winner,
+            final_depth: p.final_depth,
+        }
+    }
+
+    fn varyings(&self) -> VaryingSet {
+        self.varyings
+    }
+
+    fn line_under(
+        &self,
+        obj: &SceneObject,
+        wires: Option<Option<&DepthBuffer>>,
+        triangle: Option<u32>,
+        target: Target,
+        x: u32,
+        y: u32,
+    ) -> Option<([u32; 2], ScreenLine, i64)> {
+        let wires = wires.map(|d| (obj.edges.as_slice(), d));
+        line_under(
+            &self.cache,
+            &obj.mesh.indices,
+            wires,
+            triangle,
+            target,
+            x,
+            y,
+        )
+    }
+
+    fn project_edge(&self, edge: [u32; 2], target: Target) -> Option<ScreenLine> {
+        project_edge(&self.cache, edge, target)
+    }
+}
+
+/// The pipeline for a varying set: the narrowest of [`PACKED_WIDTHS`] that holds it.
+#[must_use]
+pub fn pipeline_for(varyings: VaryingSet) -> Box<dyn ObjectPipeline> {
+    fn new<const K: usize>(varyings: VaryingSet) -> Box<dyn ObjectPipeline> {
+        Box::new(Pipeline::<K> {
+            cache: VertexCache::default(),
+            varyings,
+        })
+    }
+    match Layout::new(varyings).len {
+        0 => new::<0>(varyings),
+        1..=4 => new::<4>(varyings),
+        5..=8 => new::<8>(varyings),
+        _ => new::<12>(varyings),
+    }
+}

@@ -183,13 +183,17 @@ pub struct Scene {
     pub plan: Plan,
 }
 
+/// The ambient term of [`standard_lights`] (the lane-code Lambert of the standard
+/// plan takes it as its material's).
+pub const STANDARD_AMBIENT: f32 = 0.08;
+
 /// The lights a lit object gets when the scene declares none.
 #[must_use]
 pub fn standard_lights() -> Vec<LightDesc> {
     vec![
         LightDesc {
             kind: LightKind::Ambient,
-            color: Vec3::splat(0.08),
+            color: Vec3::splat(STANDARD_AMBIENT),
             vector: Vec3::ZERO,
         },
         LightDesc {

@@ -4,8 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
+use termrast::cli::view_cmd::load_model;
 use termrast::counters::{self, Stage};
 use termrast::raster::Target;
+use termrast::render::standard::{StandardFrame, StandardView};
+use termrast::render::wire::Mode;
+use termrast::render::{DrawOptions, Rgba8};
 use termrast::scene::render::{SceneFrame, SceneView};
 use termrast::scene::{Scene, SceneError};
 
@@ -292,4 +296,47 @@ fn render_plan_and_bad_scene_from_the_command_line() {
         "{err}"
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Pass: an object whose plan is exactly the standard one (a model's default scene,
+/// and the coloured lit teapot) is drawn by the lane-code Lambert pipeline, and a
+/// model's scene has the bits of the model's standard frame seen the same way; any
+/// other plan takes the packed shader.
+#[test]
+fn the_standard_plan_takes_the_lambert_pipeline() {
+    let target = Target::new(160, 120);
+    for spec in ["teapot", "bunny"] {
+        let scene = Scene::for_model(spec).unwrap();
+        let mut frame = SceneFrame::new(&scene);
+        assert_eq!(frame.pipelines(), ["lambert"], "{spec}");
+        frame.draw(&scene, target, &SceneView::default());
+        let model = load_model(spec).unwrap();
+        let mut standard = StandardFrame::new(target);
+        let mut color = Rgba8::default();
+        standard.draw(
+            &model,
+            &StandardView::framed(&model, 1.0, 0.0),
+            target,
+            &DrawOptions::default(),
+            Mode::Fill,
+            &mut color,
+        );
+        assert!(color.0.iter().filter(|p| p[3] == 255).count() > 1000);
+        assert!(frame.color.0 == color.0, "{spec}: the frames differ");
+    }
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    for (file, pipelines) in [
+        ("lit-teapot.toml", ["lambert"]),
+        ("minimal.toml", ["packed"]),
+    ] {
+        let scene = Scene::load(&examples.join(file)).unwrap();
+        assert_eq!(SceneFrame::new(&scene).pipelines(), pipelines, "{file}");
+    }
+    let fog = Scene::from_text(
+        "[[object]]\nmodel = \"teapot\"\n[object.material]\nlighting = \"lambert\"\n\
+         [object.effects]\ndepth_test = true\nfog = { start = 2.0, end = 3.5 }\n",
+        Path::new("fog.toml"),
+    )
+    .unwrap();
+    assert_eq!(SceneFrame::new(&fog).pipelines(), ["packed"]);
 }

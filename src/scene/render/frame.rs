@@ -70,10 +70,10 @@ impl SceneFrame {
             color: Rgba8::default(),
             fine: Rgba8::default(),
             pipelines: scene
-                .plan
                 .objects
                 .iter()
-                .map(|o| pipeline_for(o.varyings))
+                .zip(&scene.plan.objects)
+                .map(|(o, op)| pipeline_for(o, op, &scene.lights))
                 .collect(),
             silhouettes: Vec::new(),
             stats: DrawStats::default(),
@@ -85,6 +85,13 @@ impl SceneFrame {
     #[must_use]
     pub fn varyings(&self) -> Vec<VaryingSet> {
         self.pipelines.iter().map(|p| p.varyings()).collect()
+    }
+
+    /// The shading each object's pipeline draws with: `"lambert"` for the standard
+    /// plan's lane-code Lambert, else `"packed"`.
+    #[must_use]
+    pub fn pipelines(&self) -> Vec<&'static str> {
+        self.pipelines.iter().map(|p| p.name()).collect()
     }
 
     /// Draws a frame of `target` samples.

@@ -1,6 +1,6 @@
-//! One object's pipeline: its shader compiled for the narrowest packed width that
-//! holds its varyings, its vertex cache, and what it draws (fill, wireframe,
-//! silhouettes, the probe).
+//! One object's pipeline: its shader (the lane-code Lambert for the standard plan,
+//! else the packed shader at the narrowest width that holds its varyings), its vertex
+//! cache, and what it draws (fill, wireframe, silhouettes, the probe).
 
 use glam::{Vec2, Vec4};
 
@@ -8,14 +8,17 @@ use super::*;
 use crate::counters::{self, Stage};
 use crate::raster::Target;
 use crate::raster::depth::{DepthBuffer, DepthState};
+use crate::raster::interp::Varying;
 use crate::render::probe::{Probe, probe_from};
 use crate::render::standard::WIRE_COLOR;
 use crate::render::wire::{
     ScreenLine, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under, project_edge,
 };
-use crate::render::{Cull, DrawOptions, Renderer, Rgba8, VertexCache, ndc_to_screen, transform};
-use crate::scene::SceneObject;
+use crate::render::{
+    Cull, DrawOptions, Renderer, Rgba8, Shader, VertexCache, ndc_to_screen, transform,
+};
 use crate::scene::plan::{ObjectPlan, VaryingSet};
+use crate::scene::{LightDesc, SceneObject};
 
 /// A silhouette edge on screen, in sample coordinates (pixel centres at +0.5).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,6 +66,8 @@ pub trait ObjectPipeline {
     ) -> Probe<()>;
     /// The varying set this pipeline was compiled for.
     fn varyings(&self) -> VaryingSet;
+    /// Which shading it draws with ([`Shading::NAME`]).
+    fn name(&self) -> &'static str;
     /// The line under a pixel (see [`line_under`]), from this frame's vertices.
     fn line_under(
         &self,
@@ -91,13 +96,48 @@ pub fn draw_options(plan: &ObjectPlan) -> DrawOptions {
     }
 }
 
-/// The pipeline of objects whose varyings fit `K` floats.
-struct Pipeline<const K: usize> {
-    cache: VertexCache<[f32; K]>,
+/// How a pipeline makes its object's shader for a frame: the packed shader of any
+/// plan ([`Packed`]), or the lane-code Lambert of the standard plan ([`StandardLambert`]).
+pub trait Shading: 'static {
+    /// What the pipeline is called (tests and diagnostics).
+    const NAME: &'static str;
+    type Varying: Varying;
+    type Instance<'a>: Shader<Varying = Self::Varying>;
+    /// The object's shader at this frame.
+    fn shader<'a>(
+        obj: &'a SceneObject,
+        plan: &'a ObjectPlan,
+        ctx: FrameCtx<'a>,
+    ) -> Self::Instance<'a>;
+    /// Adds to the work counters what the shader does not count itself, after a draw
+    /// that shaded `shaded` fragments.
+    fn count_work(_obj: &SceneObject, _shaded: u64) {}
+}
+
+/// [`ObjectShader`] with its varyings packed in `K` floats.
+pub struct Packed<const K: usize>;
+
+impl<const K: usize> Shading for Packed<K> {
+    const NAME: &'static str = "packed";
+    type Varying = [f32; K];
+    type Instance<'a> = ObjectShader<'a, K>;
+
+    fn shader<'a>(
+        obj: &'a SceneObject,
+        plan: &'a ObjectPlan,
+        ctx: FrameCtx<'a>,
+    ) -> ObjectShader<'a, K> {
+        ObjectShader::new(obj, plan, ctx)
+    }
+}
+
+/// An object's pipeline: the shading it was chosen for, its vertex cache.
+struct Pipeline<S: Shading> {
+    cache: VertexCache<S::Varying>,
     varyings: VaryingSet,
 }
 
-impl<const K: usize> ObjectPipeline for Pipeline<K> {
+impl<S: Shading> ObjectPipeline for Pipeline<S> {
     fn draw(
         &mut self,
         obj: &SceneObject,
@@ -106,8 +146,9 @@ impl<const K: usize> ObjectPipeline for Pipeline<K> {
         r: &mut Renderer,
         color: &mut Rgba8,
     ) {
-        let shader = ObjectShader::<K>::new(obj, plan, ctx);
+        let shader = S::shader(obj, plan, ctx);
         transform(&shader, obj.mesh.positions.len(), &mut self.cache);
+        let shaded = r.stats.shaded;
         r.draw(
             &shader,
             &self.cache,
@@ -115,6 +156,7 @@ impl<const K: usize> ObjectPipeline for Pipeline<K> {
             &draw_options(plan),
             color,
         );
+        S::count_work(obj, r.stats.shaded - shaded);
     }
 
     fn wireframe(
@@ -228,6 +270,10 @@ impl<const K: usize> ObjectPipeline for Pipeline<K> {
         self.varyings
     }
 
+    fn name(&self) -> &'static str {
+        S::NAME
+    }
+
     fn line_under(
         &self,
         obj: &SceneObject,
@@ -254,19 +300,29 @@ impl<const K: usize> ObjectPipeline for Pipeline<K> {
     }
 }
 
-/// The pipeline for a varying set: the narrowest of [`PACKED_WIDTHS`] that holds it.
+/// The pipeline for an object of a scene lit by `lights`: the lane-code Lambert when
+/// its plan is exactly the standard one ([`is_standard_lambert`]), else the packed
+/// shader at the narrowest of [`PACKED_WIDTHS`] that holds its varyings.
 #[must_use]
-pub fn pipeline_for(varyings: VaryingSet) -> Box<dyn ObjectPipeline> {
-    fn new<const K: usize>(varyings: VaryingSet) -> Box<dyn ObjectPipeline> {
-        Box::new(Pipeline::<K> {
+pub fn pipeline_for(
+    obj: &SceneObject,
+    plan: &ObjectPlan,
+    lights: &[LightDesc],
+) -> Box<dyn ObjectPipeline> {
+    fn new<S: Shading>(varyings: VaryingSet) -> Box<dyn ObjectPipeline> {
+        Box::new(Pipeline::<S> {
             cache: VertexCache::default(),
             varyings,
         })
     }
+    let varyings = plan.varyings;
+    if is_standard_lambert(obj, plan, lights) {
+        return new::<StandardLambert>(varyings);
+    }
     match Layout::new(varyings).len {
-        0 => new::<0>(varyings),
-        1..=4 => new::<4>(varyings),
-        5..=8 => new::<8>(varyings),
-        _ => new::<12>(varyings),
+        0 => new::<Packed<0>>(varyings),
+        1..=4 => new::<Packed<4>>(varyings),
+        5..=8 => new::<Packed<8>>(varyings),
+        _ => new::<Packed<12>>(varyings),
     }
 }

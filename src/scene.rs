@@ -73,6 +73,9 @@ pub enum SceneError {
         line: Option<usize>,
         problem: String,
     },
+    /// A model's own error, for its default scene (which adds nothing to say).
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
     #[error("{scene}: object {object}: {source}")]
     Model {
         scene: PathBuf,
@@ -241,7 +244,11 @@ impl Scene {
             "[[object]]\nmodel = {}\n[object.material]\nlighting = \"lambert\"\n[object.effects]\ndepth_test = true\n",
             toml::Value::String(spec.to_string())
         );
-        let mut scene = Self::from_text(&text, Path::new("default scene"))?;
+        let mut scene =
+            Self::from_text(&text, Path::new("default scene")).map_err(|e| match e {
+                SceneError::Model { source, .. } => SceneError::Mesh(source),
+                e => e,
+            })?;
         scene.source = format!("{spec} (default scene)");
         let radius = scene.objects[0].mesh.bounding_radius();
         scene.rig = Rig::Turntable {

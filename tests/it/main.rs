@@ -16,7 +16,6 @@ mod lines;
 mod link;
 mod mesh;
 mod model_frames;
-mod onepath;
 mod pipeline;
 mod scenes;
 mod terminal;

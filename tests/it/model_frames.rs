@@ -3,24 +3,43 @@
 //! (every wire mode, culling on and off, every interpolation, the benchmark's fixed
 //! camera and the viewer's framed one, zoomed, at several pixel aspects) and of the
 //! viewport's cells in every glyph and colour mode, and the inspector's text, for the
-//! teapot, the bunny and a sphere. The snapshot was recorded from that model path.
+//! teapot, the bunny and a sphere. The snapshots were recorded from that model path
+//! (`StandardFrame`, `Viewport::render` and the model inspector), before models
+//! became one-object scenes.
 
 use std::fmt::Write as _;
 
 use termrast::raster::interp::Interpolation;
 use termrast::raster::{Target, Traversal};
-use termrast::render::Cull;
 use termrast::render::wire::Mode;
+use termrast::scene::Scene;
+use termrast::scene::render::{SceneFrame, SceneView};
 use termrast::terminal::{ColorMode, GlyphMode};
+use termrast::tui::app::App;
+use termrast::tui::inspector::inspector_text;
 use termrast::tui::viewport::ViewSettings;
 
 const MODELS: [&str; 3] = ["teapot", "bunny", "sphere:20000"];
 
 /// FNV-1a, 64 bits.
-fn hash(bytes: impl IntoIterator<Item = u8>) -> u64 {
+pub fn hash(bytes: impl IntoIterator<Item = u8>) -> u64 {
     bytes.into_iter().fold(0xcbf2_9ce4_8422_2325, |h, b| {
         (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
     })
+}
+
+/// The colour hash recorded for a shot of a model (by [`Shot::name`]).
+pub fn recorded_colour(spec: &str, shot: &str) -> u64 {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/it/snapshots/it__model_frames__model_frames_keep_their_bits.snap"
+    );
+    let text = std::fs::read_to_string(path).expect("the recorded frames");
+    let line = text
+        .lines()
+        .find_map(|l| l.strip_prefix(&format!("{spec} {shot}: colour ")))
+        .unwrap_or_else(|| panic!("no recorded frame {spec} {shot}"));
+    u64::from_str_radix(&line[..16], 16).expect("a hash")
 }
 
 /// One frame of a model as the command line and the tests draw it.
@@ -142,27 +161,25 @@ fn shots() -> Vec<Shot> {
 /// The frame's colour, its depth bits when it fills triangles, and its triangles
 /// drawn and culled.
 fn draw(spec: &str, s: &Shot) -> (Vec<[u8; 4]>, Option<Vec<u32>>, [u64; 2]) {
-    use termrast::cli::view_cmd::load_model;
-    use termrast::render::standard::{StandardFrame, StandardView};
-    use termrast::render::{DrawOptions, Rgba8};
-    let model = load_model(spec).unwrap();
-    let target = Target::new(s.size.0, s.size.1);
-    let mut view = if s.fixed {
-        StandardView::at(s.angle)
+    let mut scene = if s.fixed {
+        Scene::standard(spec)
     } else {
-        StandardView::framed(&model, s.zoom, s.angle)
+        Scene::for_model(spec)
+    }
+    .unwrap();
+    scene.set_mode(s.mode);
+    scene.set_cull(s.cull);
+    let mut frame = SceneFrame::new(&scene);
+    frame.interpolation = s.interpolation;
+    frame.traversal = s.traversal;
+    let view = SceneView {
+        time: 0.0,
+        yaw: s.angle,
+        pitch: s.tilt,
+        zoom: s.zoom,
+        pixel_aspect: s.pixel_aspect,
     };
-    view.tilt = s.tilt;
-    view.pixel_aspect = s.pixel_aspect;
-    let opts = DrawOptions {
-        cull: if s.cull { Cull::Back } else { Cull::None },
-        interpolation: s.interpolation,
-        traversal: s.traversal,
-        ..DrawOptions::default()
-    };
-    let mut frame = StandardFrame::new(target);
-    let mut color = Rgba8::default();
-    frame.draw(&model, &view, target, &opts, s.mode, &mut color);
+    frame.draw(&scene, Target::new(s.size.0, s.size.1), &view);
     let depth = s.mode.fills().then(|| {
         frame
             .renderer
@@ -172,21 +189,24 @@ fn draw(spec: &str, s: &Shot) -> (Vec<[u8; 4]>, Option<Vec<u32>>, [u64; 2]) {
             .map(|d| d.to_bits())
             .collect()
     });
-    let stats = frame.renderer.stats;
-    (color.0, depth, [stats.drawn, stats.culled])
+    (
+        frame.color.0,
+        depth,
+        [frame.stats.drawn, frame.stats.culled],
+    )
 }
 
-/// A viewer of the model at 70×22 cells, paused.
-fn viewer(spec: &str, settings: ViewSettings) -> termrast::tui::app::App {
-    let model = termrast::cli::view_cmd::load_model(spec).unwrap();
-    let mut app = termrast::tui::app::App::new(model, settings);
+/// A viewer of the model, paused.
+fn viewer(spec: &str, settings: ViewSettings) -> App {
+    let mut app = App::new(Scene::for_model(spec).unwrap(), settings);
     app.paused = true;
     app
 }
 
 /// The viewer's cells (glyph and colours) after a frame of `cols × rows`.
-fn cells(app: &mut termrast::tui::app::App, cols: u16, rows: u16) -> String {
-    app.viewport.render(&app.model, &app.settings, cols, rows);
+fn cells(app: &mut App, cols: u16, rows: u16) -> String {
+    app.viewport
+        .render(&mut app.scene, &app.settings, (cols, rows));
     let mut out = String::new();
     for c in &app.viewport.cells {
         let _ = write!(out, "{}{:?}{:?}", c.ch, c.fg, c.bg);
@@ -195,13 +215,13 @@ fn cells(app: &mut termrast::tui::app::App, cols: u16, rows: u16) -> String {
 }
 
 /// The inspector's text for cell `(cx, cy)`, sample `sub`.
-fn inspector(app: &termrast::tui::app::App, cx: u16, cy: u16, sub: usize) -> String {
-    termrast::tui::inspector::inspector_text(&app.viewport, &app.model, cx, cy, sub).plain()
+fn inspector(app: &App, cx: u16, cy: u16, sub: usize) -> String {
+    inspector_text(&app.viewport, &app.scene, cx, cy, sub).plain()
 }
 
-fn set_look(app: &mut termrast::tui::app::App, mode: Mode, cull: bool) {
-    app.settings.mode = mode;
-    app.settings.cull = cull;
+fn set_look(app: &mut App, mode: Mode, cull: bool) {
+    app.scene.scene.set_mode(mode);
+    app.scene.scene.set_cull(cull);
 }
 
 #[test]

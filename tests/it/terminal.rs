@@ -2,8 +2,8 @@
 
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
-use termrast::render::standard::Model;
 use termrast::render::wire::Mode;
+use termrast::scene::Scene;
 use termrast::terminal::glyphs::{FitSpace, Sample, braille, fit_cell, sextant};
 use termrast::terminal::{ColorMode, GlyphMode};
 use termrast::tui::app::App;
@@ -181,10 +181,8 @@ fn colour_detection_table() {
     );
 }
 
-fn teapot() -> Model {
-    let mut m = termrast::mesh::Mesh::teapot();
-    m.ensure_normals();
-    Model::new(m)
+fn teapot() -> Scene {
+    Scene::for_model("teapot").unwrap()
 }
 
 fn app(glyphs: GlyphMode) -> App {
@@ -221,11 +219,11 @@ fn viewport_snapshots_in_every_glyph_mode() {
 fn inspector_and_line_panel_snapshots() {
     let mut a = app(GlyphMode::Quadrant);
     a.inspect = true;
-    a.settings.mode = Mode::FillWire;
+    a.scene.scene.set_mode(Mode::FillWire);
     a.cursor = (31, 19);
     let mut t = Terminal::new(TestBackend::new(120, 40)).unwrap();
     t.draw(|f| a.draw(f)).unwrap();
-    let text = inspector_text(&a.viewport, &a.model, a.cursor.0, a.cursor.1, 0).plain();
+    let text = inspector_text(&a.viewport, &a.scene, a.cursor.0, a.cursor.1, 0).plain();
     assert!(
         [
             "F01", "F02", "F03", "area2", " u ", " v ", " w ", "1/w", "depth", "block"
@@ -236,7 +234,7 @@ fn inspector_and_line_panel_snapshots() {
     );
     insta::assert_snapshot!("inspector_cell_31_19", text);
     let (focus, sl) =
-        line_at_sample(&a.viewport, &a.model, None, (31, 19, 0)).expect("a line near the cell");
+        line_at_sample(&a.viewport, &a.scene, (31, 19, 0)).expect("a line near the cell");
     let panel = line_text(focus, &sl).plain();
     assert!(
         ["octant", "dx", "dy", "incrE", "incrNE", " d "]
@@ -308,7 +306,7 @@ fn the_line_panel_works_for_scenes() {
     let scene =
         termrast::scene::Scene::load(std::path::Path::new("examples/scenes/lit-teapot.toml"))
             .unwrap();
-    let mut a = App::with_scene(
+    let mut a = App::new(
         scene,
         ViewSettings {
             glyphs: GlyphMode::Blocks,
@@ -342,7 +340,7 @@ fn the_plan_overlay_wraps() {
         termrast::scene::Scene::load(std::path::Path::new("examples/scenes/phong-bunny.toml"))
             .unwrap();
     let plan = scene.plan.to_string();
-    let mut a = App::with_scene(scene, ViewSettings::default());
+    let mut a = App::new(scene, ViewSettings::default());
     let mut t = Terminal::new(TestBackend::new(50, 60)).unwrap();
     key(&mut a, KeyCode::Char('p'));
     t.draw(|f| a.draw(f)).unwrap();

@@ -17,6 +17,10 @@ use crate::render::{DrawOptions, DrawStats, Renderer, Rgba8};
 use crate::scene::plan::{ObjectPlan, VaryingSet};
 use crate::scene::{Rig, Scene, SceneObject};
 
+/// A probe of one object at a pixel, each record carrying the colour its fragment
+/// was shaded (if it passed the depth test).
+pub type ShadedProbe = Probe<Option<Vec3>>;
+
 /// Where a scene is seen from in one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneView {
@@ -236,7 +240,7 @@ impl SceneFrame {
     /// record carries the colour its fragment was shaded, if it passed. Empty before
     /// the first frame.
     #[must_use]
-    pub fn probe(&self, scene: &Scene, x: u32, y: u32) -> Vec<Probe<Option<Vec3>>> {
+    pub fn probe(&self, scene: &Scene, x: u32, y: u32) -> Vec<ShadedProbe> {
         let Some(ctx) = self.ctx else {
             return Vec::new();
         };

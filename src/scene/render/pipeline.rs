@@ -12,10 +12,10 @@ use crate::raster::Target;
 use crate::raster::depth::{DepthBuffer, DepthState};
 use crate::raster::interp::Varying;
 use crate::render::probe::{DepthOutcome, Probe, probe_from};
-use crate::render::standard::WIRE_COLOR;
+
 use crate::render::wire::{
-    LineHit, ScreenLine, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under, probe_lines,
-    project_edge,
+    LineHit, ScreenLine, WIRE_COLOR, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under,
+    probe_lines, project_edge,
 };
 use crate::render::{
     Cull, DrawOptions, Renderer, Rgba8, Shader, VertexCache, ndc_to_screen, transform,

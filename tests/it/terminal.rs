@@ -332,6 +332,41 @@ fn the_line_panel_works_for_scenes() {
     assert!(a.line_focus.is_some_and(|f| f.object == Some(0)));
 }
 
+/// `w` and `b` act on a scene file's objects: the status line and the plan follow.
+#[test]
+fn w_and_b_change_what_a_scene_draws() {
+    use ratatui::crossterm::event::KeyCode;
+    let scene =
+        termrast::scene::Scene::load(std::path::Path::new("examples/scenes/lit-teapot.toml"))
+            .unwrap();
+    let mut a = App::new(
+        scene,
+        ViewSettings {
+            glyphs: GlyphMode::Blocks,
+            ..ViewSettings::default()
+        },
+    );
+    let mut t = Terminal::new(TestBackend::new(200, 40)).unwrap();
+    t.draw(|f| a.draw(f)).unwrap();
+    let s = status_line(&t);
+    assert!(s.contains("fill no cull"), "{s}");
+    key(&mut a, KeyCode::Char('w'));
+    key(&mut a, KeyCode::Char('b'));
+    t.draw(|f| a.draw(f)).unwrap();
+    let s = status_line(&t);
+    let lines: u64 = s
+        .split_once("wire ")
+        .and_then(|(_, r)| r.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .expect("a line count");
+    assert!(lines > 100 && s.contains(" cull"), "{s}");
+    let plan = a.scene.scene.plan.to_string();
+    assert!(
+        plan.contains("wireframe: on") && plan.contains("back-face culling: on"),
+        "{plan}"
+    );
+}
+
 /// The plan overlay wraps long lines instead of cutting them.
 #[test]
 fn the_plan_overlay_wraps() {

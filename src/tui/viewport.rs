@@ -135,9 +135,11 @@ impl Viewport {
         let target = self.lay_out(settings, cols, rows);
         self.view = settings.view(s.time);
         let frame = &mut s.frame;
+        // One colour buffer passes between the two: the frame is drawn into the
+        // viewport's last one, which then holds it.
+        std::mem::swap(&mut self.color, &mut frame.color);
         frame.draw(&s.scene, target, &self.view);
         self.wire = frame.wire;
-        // The finished frame becomes the viewport's; its old buffer is drawn into next.
         std::mem::swap(&mut self.color, &mut frame.color);
         self.fit_cells();
         for e in &frame.silhouettes {

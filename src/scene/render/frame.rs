@@ -178,15 +178,7 @@ impl SceneFrame {
             time: view.time,
             turn,
         };
-        self.ctx = Some(FrameCtx {
-            view_proj,
-            eye,
-            forward,
-            lights: &[],
-            depth_range,
-            time: view.time,
-            turn,
-        });
+        self.ctx = Some(ctx.without_lights());
         let color = if side > 1 {
             &mut self.fine
         } else {

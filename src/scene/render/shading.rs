@@ -94,6 +94,21 @@ impl FrameCtx<'_> {
         let m = obj.desc.model_matrix(self.time);
         self.turn.map_or(m, |t| t * m)
     }
+
+    /// The same context without its lights, to keep past the frame (the probe gives
+    /// them back).
+    #[must_use]
+    pub fn without_lights(&self) -> FrameCtx<'static> {
+        FrameCtx {
+            view_proj: self.view_proj,
+            eye: self.eye,
+            forward: self.forward,
+            lights: &[],
+            depth_range: self.depth_range,
+            time: self.time,
+            turn: self.turn,
+        }
+    }
 }
 
 /// The shader of one object, its varyings packed in `K` floats by [`Layout`].

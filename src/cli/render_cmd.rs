@@ -241,6 +241,7 @@ fn text_frames(
             &vp.cells,
             usize::from(vp.cols),
             vp.settings.colors,
+            &vp.settings.palette,
             args.animate,
             &mut out,
         )?;

@@ -66,19 +66,17 @@ pub struct Outcome {
 /// The terminal palettes of the benchmark: xterm's, and chafa's own.
 pub const PALETTES: [Palette; 2] = [Palette::XTERM, Palette::CHAFA];
 
-/// The palettes a frame of `source` at depth `colors` is painted with: xterm's always,
-/// and chafa's too where the frame's colours depend on it. chafa fits its 16- and
-/// 256-colour output to its own 16 ANSI colours ([`Palette::CHAFA`]; at 256 colours it
-/// picks indices 0–15 where one is nearest) whatever the terminal has, so its frames
-/// are shown on the palette it assumes and on xterm's. termrast fits its 16-colour
-/// output to the palette the terminal reports, so each of its 16-colour frames is
-/// fitted to the palette it is painted on ([`measure_view`] renders one per palette).
-/// termrast's 256-colour frames use only the cube and grey ramp (16–255), which the
-/// palettes share.
+/// The palettes a frame at depth `colors` is painted with: xterm's always, and chafa's
+/// too where the frame's colours depend on it (16 and 256 colours). chafa fits to its
+/// own 16 ANSI colours ([`Palette::CHAFA`]; at 256 colours it picks indices 0–15 where
+/// one is nearest) whatever the terminal has, so its frames are shown on the palette
+/// it assumes and on xterm's. termrast fits to the palette the terminal reports (at 256
+/// colours using 0–15 only then), so each of its indexed frames is fitted to the
+/// palette it is painted on ([`measure_view`] renders one per palette).
 #[must_use]
-pub fn palettes(source: Source, colors: ColorMode) -> &'static [Palette] {
-    match (source, colors) {
-        (_, ColorMode::Ansi16) | (Source::Chafa, ColorMode::Ansi256) => &PALETTES,
+pub fn palettes(colors: ColorMode) -> &'static [Palette] {
+    match colors {
+        ColorMode::Ansi16 | ColorMode::Ansi256 => &PALETTES,
         _ => &[Palette::XTERM],
     }
 }
@@ -309,7 +307,7 @@ fn measure_view(
         };
         let depths = ColorMode::ALL
             .into_iter()
-            .flat_map(|c| palettes(Source::Termrast, c).iter().map(move |p| (c, *p)));
+            .flat_map(|c| palettes(c).iter().map(move |p| (c, *p)));
         for (colors, palette) in depths {
             let settings = ViewSettings {
                 glyphs,
@@ -317,7 +315,8 @@ fn measure_view(
                 angle: view.angle,
                 tilt: view.tilt,
                 fit_space,
-                palette,
+                // As the viewer has it once the terminal has answered.
+                palette: palette.reported(),
                 ..ViewSettings::default()
             };
             vp.render(model, &settings, cols, rows);
@@ -422,7 +421,7 @@ fn measure_chafa(
             match chafa.convert(&input.path, config.cols, config.rows, set, colors) {
                 Ok(bytes) => {
                     let id = (view, Source::Chafa, set, colors);
-                    let on = palettes(Source::Chafa, colors);
+                    let on = palettes(colors);
                     measure(config, reference, &bytes, id, on, &mut out.measurements)?;
                 }
                 Err(e) => out.notes.push(format!("{}: {e}", view.name())),
@@ -446,7 +445,7 @@ mod tests {
         let n = variants().count()
             * ColorMode::ALL
                 .iter()
-                .map(|&c| palettes(Source::Termrast, c).len())
+                .map(|&c| palettes(c).len())
                 .sum::<usize>();
         assert_eq!(o.measurements.len(), n);
         for m in &o.measurements {
@@ -482,18 +481,14 @@ mod tests {
     }
 
     #[test]
-    fn chafa_is_painted_on_its_own_palette_where_it_uses_one() {
-        for source in [Source::Termrast, Source::Chafa] {
-            assert_eq!(palettes(source, ColorMode::Truecolor), [Palette::XTERM]);
-            assert_eq!(palettes(source, ColorMode::None), [Palette::XTERM]);
-            assert_eq!(palettes(source, ColorMode::Ansi16), PALETTES);
-        }
-        assert_eq!(palettes(Source::Chafa, ColorMode::Ansi256), PALETTES);
-        assert_eq!(
-            palettes(Source::Termrast, ColorMode::Ansi256),
-            [Palette::XTERM]
-        );
-        // termrast's 256-colour frames never use the indices the palettes differ in.
+    fn indexed_frames_are_painted_on_every_palette() {
+        assert_eq!(palettes(ColorMode::Truecolor), [Palette::XTERM]);
+        assert_eq!(palettes(ColorMode::None), [Palette::XTERM]);
+        assert_eq!(palettes(ColorMode::Ansi16), PALETTES);
+        assert_eq!(palettes(ColorMode::Ansi256), PALETTES);
+        // termrast's 256-colour frames use the indices the palettes differ in only
+        // where the terminal reported its palette.
+        let mut low = 0;
         for i in 0..=255u8 {
             let c = ColorMode::Ansi256.color([i, i / 2, 255 - i], &Palette::XTERM);
             let grey = ColorMode::Ansi256.color([i; 3], &Palette::XTERM);
@@ -503,6 +498,9 @@ mod tests {
                     "{c:?}"
                 );
             }
+            let reported = ColorMode::Ansi256.color([i; 3], &Palette::CHAFA.reported());
+            low += usize::from(matches!(reported, ratatui::style::Color::Indexed(n) if n < 16));
         }
+        assert!(low > 0);
     }
 }

@@ -82,7 +82,7 @@ impl ColorMode {
     pub fn color(self, c: Rgb, palette: &Palette) -> Color {
         match self {
             ColorMode::Truecolor => Color::Rgb(c[0], c[1], c[2]),
-            ColorMode::Ansi256 => Color::Indexed(nearest_256(c)),
+            ColorMode::Ansi256 => Color::Indexed(palette.nearest_256(c)),
             ColorMode::Ansi16 => ANSI16[usize::from(palette.nearest(c))],
             ColorMode::None => Color::Reset,
         }

@@ -14,6 +14,9 @@ pub struct Palette {
     /// Where the colours come from, for the status line and the benchmark.
     pub name: &'static str,
     pub ansi: [Rgb; 16],
+    /// The terminal said these are its colours (not an assumption): the 256-colour
+    /// mode may then use them too.
+    pub reported: bool,
 }
 
 impl Default for Palette {
@@ -26,6 +29,7 @@ impl Palette {
     /// xterm's default colours, assumed where the terminal does not say.
     pub const XTERM: Self = Self {
         name: "xterm",
+        reported: false,
         ansi: [
             [0, 0, 0],
             [205, 0, 0],
@@ -52,6 +56,7 @@ impl Palette {
     /// nearest.
     pub const CHAFA: Self = Self {
         name: "chafa",
+        reported: false,
         ansi: [
             [0x00, 0x00, 0x00],
             [0x80, 0x00, 0x00],
@@ -97,13 +102,46 @@ impl Palette {
         best.1
     }
 
-    /// This palette with entry `i` set to `c` (as the terminal reported it).
+    /// This palette with entry `i` set to `c`, as the terminal reported it.
     #[must_use]
     pub fn with(mut self, i: u8, c: Rgb) -> Self {
         if let Some(e) = self.ansi.get_mut(usize::from(i)) {
             *e = c;
+            self.name = "terminal";
+            self.reported = true;
         }
         self
+    }
+
+    /// This palette, as reported by the terminal.
+    #[must_use]
+    pub fn reported(self) -> Self {
+        Self {
+            reported: true,
+            ..self
+        }
+    }
+
+    /// The index (0–255) of the 256-colour entry nearest `c`: the cube and grey ramp,
+    /// and the 16 colours too where the terminal reported them (an assumed palette
+    /// may be a theme's, so then they are left alone).
+    #[must_use]
+    pub fn nearest_256(&self, c: Rgb) -> u8 {
+        let cube = super::color::nearest_256(c);
+        if !self.reported {
+            return cube;
+        }
+        let d = |p: Rgb| {
+            (0..3)
+                .map(|k| (i32::from(p[k]) - i32::from(c[k])).pow(2))
+                .sum::<i32>()
+        };
+        let low = self.nearest(c);
+        if d(self.ansi[usize::from(low)]) < d(indexed_rgb(cube)) {
+            low
+        } else {
+            cube
+        }
     }
 }
 
@@ -193,5 +231,19 @@ mod tests {
         }
         assert_eq!(Palette::XTERM.with(7, [1, 2, 3]).rgb(7), [1, 2, 3]);
         assert_eq!(Palette::XTERM.with(20, [1, 2, 3]), Palette::XTERM);
+    }
+
+    #[test]
+    fn the_256_colour_mode_uses_the_16_only_where_reported() {
+        // chafa's 7 is #c0c0c0, between the grey ramp's #bcbcbc and #c6c6c6.
+        let grey = [0xc0; 3];
+        assert_eq!(
+            Palette::CHAFA.nearest_256(grey),
+            super::super::color::nearest_256(grey)
+        );
+        assert_eq!(Palette::CHAFA.reported().nearest_256(grey), 7);
+        let reported = Palette::XTERM.with(3, [1, 2, 3]);
+        assert_eq!(reported.nearest_256([1, 2, 3]), 3);
+        assert_eq!(reported.nearest_256([255, 0, 0]), 196);
     }
 }

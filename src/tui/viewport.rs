@@ -69,13 +69,10 @@ impl ViewSettings {
     /// Takes colour `i` of the terminal's palette as it reported it; whether that
     /// changes what a 16-colour frame looks like.
     pub fn terminal_color(&mut self, i: u8, c: crate::terminal::Rgb) -> bool {
-        let p = Palette {
-            name: "terminal",
-            ..self.palette.with(i, c)
-        };
-        let changed = p.ansi != self.palette.ansi;
+        let p = self.palette.with(i, c);
+        let changed = p != self.palette;
         self.palette = p;
-        changed && self.colors == ColorMode::Ansi16
+        changed && matches!(self.colors, ColorMode::Ansi16 | ColorMode::Ansi256)
     }
 
     /// Draw options of the viewer.

@@ -7,7 +7,8 @@
 //! ordered by luminance, where the summed squared colour error of the two groups is
 //! smallest; block modes draw the brighter group in the foreground, braille puts its
 //! dots on the smaller group (dots ink only a third of the cell, so the colour that
-//! covers the cell's area is the background). A cell of one colour is a space on that
+//! covers the cell's area is the background) in a colour strengthened so that a dot's
+//! sample looks like its group from a distance. A cell of one colour is a space on that
 //! background in every mode that has one; without colour, shading is carried by ink
 //! density.
 
@@ -302,7 +303,8 @@ pub fn explain(mode: GlyphMode, samples: &[Sample], g: &CellGlyph) -> String {
         _ => {
             let on = g.pattern.count_ones();
             let rule = if mode == GlyphMode::Braille {
-                "the smaller group on the dots"
+                "the smaller group on the dots, their colour strengthened for the third \
+                 of a sample a dot inks"
             } else {
                 "the brighter group in fg"
             };

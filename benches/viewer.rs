@@ -135,6 +135,7 @@ fn breakdown() {
                         glyphs,
                         ColorMode::Truecolor,
                         FitSpace::Srgb,
+                        &termrast::terminal::Palette::XTERM,
                         sample_rows,
                         &mut out[..n],
                     );

@@ -29,6 +29,9 @@ pub struct Config {
     pub presses: usize,
     /// Longest wait for one key's effect.
     pub timeout: Duration,
+    /// The 16 colours the emulated terminal reports to OSC 4 queries (`None`: it
+    /// ignores them, as tmux and many terminals do).
+    pub palette: Option<[[u8; 3]; 16]>,
 }
 
 impl Config {
@@ -44,6 +47,7 @@ impl Config {
             rows: 61,
             presses: 8,
             timeout: Duration::from_secs(20),
+            palette: None,
         }
     }
 }
@@ -83,11 +87,17 @@ pub enum LinkError {
 }
 
 #[cfg(target_os = "linux")]
-pub use linux::run;
+pub use linux::{run, screen_after};
 
 /// Runs the viewer behind a slow link (Linux only).
 #[cfg(not(target_os = "linux"))]
 pub fn run(_: &Config) -> Result<Report, LinkError> {
+    Err(LinkError::Unsupported)
+}
+
+/// The emulated screen `after` the viewer's first frame (Linux only).
+#[cfg(not(target_os = "linux"))]
+pub fn screen_after(_: &Config, _: Duration) -> Result<vt100::Screen, LinkError> {
     Err(LinkError::Unsupported)
 }
 
@@ -145,6 +155,7 @@ mod linux {
         delivered: u64,
         frames: u64,
         max_buffered: usize,
+        palette: Option<[[u8; 3]; 16]>,
     }
 
     impl Link {
@@ -175,22 +186,53 @@ mod linux {
             };
             parser.process(&self.chunk);
             self.delivered += self.chunk.len() as u64;
-            let n = queries(&mut self.tail, &self.chunk);
-            self.frames += n as u64;
-            for _ in 0..n {
-                writer.write_all(b"\x1b[?62;22c")?;
+            // Answers in the order the queries were reached, as a terminal does.
+            for q in queries(&mut self.tail, &self.chunk) {
+                match q {
+                    None => {
+                        self.frames += 1;
+                        writer.write_all(b"\x1b[?62;22c")?;
+                    }
+                    Some(i) => {
+                        if let Some(p) = &self.palette {
+                            let [r, g, b] = p[usize::from(i)].map(|v| u16::from(v) * 257);
+                            let reply = format!("\x1b]4;{i};rgb:{r:04x}/{g:04x}/{b:04x}\x1b\\");
+                            writer.write_all(reply.as_bytes())?;
+                        }
+                    }
+                }
             }
             Ok(done)
         }
     }
 
-    /// Finds `ESC [ c` in the delivered stream (`tail`: the last bytes before `chunk`).
-    fn queries(tail: &mut Vec<u8>, chunk: &[u8]) -> usize {
+    /// The queries in the delivered stream (`tail`: the last bytes before `chunk`), in
+    /// order: `ESC [ c` is `None`, an OSC 4 query of colour `i` (`ESC ] 4 ; i ; ?`) is
+    /// `Some(i)`. Each is counted where it ends, so one that ended in an earlier chunk
+    /// is not counted again.
+    fn queries(tail: &mut Vec<u8>, chunk: &[u8]) -> Vec<Option<u8>> {
+        const KEEP: usize = 8;
+        let old = tail.len();
         tail.extend_from_slice(chunk);
-        let n = tail.windows(3).filter(|w| w == b"\x1b[c").count();
-        let keep = tail.len().saturating_sub(2);
+        let mut found = Vec::new();
+        for at in 0..tail.len() {
+            let rest = &tail[at..];
+            if rest.starts_with(b"\x1b[c") && at + 3 > old {
+                found.push(None);
+            } else if let Some(body) = rest.strip_prefix(b"\x1b]4;") {
+                let digits = body.iter().take_while(|b| b.is_ascii_digit()).count();
+                let end = 4 + digits + 2;
+                if digits > 0 && body[digits..].starts_with(b";?") && at + end > old {
+                    let i = std::str::from_utf8(&body[..digits])
+                        .ok()
+                        .and_then(|s| s.parse().ok());
+                    found.extend(i.filter(|&i: &u8| i < 16).map(Some));
+                }
+            }
+        }
+        let keep = tail.len().saturating_sub(KEEP);
         tail.drain(..keep);
-        n
+        found
     }
 
     /// Whether the emulated status line says culling is on.
@@ -201,8 +243,16 @@ mod linux {
             .is_some_and(|l| l.contains(" cull |") && !l.contains("no cull"))
     }
 
-    /// Runs the viewer behind the link and times `config.presses` key presses.
-    pub fn run(config: &Config) -> Result<Report, LinkError> {
+    /// The viewer running behind the link.
+    struct Running {
+        child: std::process::Child,
+        writer: File,
+        link: Link,
+        parser: vt100::Parser,
+    }
+
+    /// Starts the viewer behind the link and waits for its first frame.
+    fn start(config: &Config) -> Result<Running, LinkError> {
         let (master, slave) = openpty(config.cols, config.rows)?;
         let mut child = {
             let mut cmd = Command::new(&config.exe);
@@ -262,7 +312,6 @@ mod linux {
             std::num::NonZeroU16::new(config.cols).unwrap_or(std::num::NonZeroU16::MIN),
             0,
         );
-        let mut report = Report::default();
         let mut link = Link {
             pipe,
             rate: config.rate as f64,
@@ -273,6 +322,7 @@ mod linux {
             delivered: 0,
             frames: 0,
             max_buffered: 0,
+            palette: config.palette,
         };
         let start = Instant::now();
         // Wait for the first frame.
@@ -284,6 +334,54 @@ mod linux {
                 return Err(LinkError::NoStart(first_wait));
             }
         }
+        Ok(Running {
+            child,
+            writer,
+            link,
+            parser,
+        })
+    }
+
+    /// Sends `q` and waits up to 5 s for the viewer to leave (then kills it).
+    fn quit(r: &mut Running) -> Result<(), LinkError> {
+        let _ = r.writer.write_all(b"q");
+        let quit = Instant::now();
+        while quit.elapsed() < Duration::from_secs(5) {
+            if r.link.step(&mut r.parser, &mut r.writer)? || r.child.try_wait()?.is_some() {
+                break;
+            }
+        }
+        if r.child.try_wait()?.is_none() {
+            let _ = r.child.kill();
+        }
+        let _ = r.child.wait();
+        Ok(())
+    }
+
+    /// The emulated screen `after` the viewer's first frame.
+    pub fn screen_after(config: &Config, after: Duration) -> Result<vt100::Screen, LinkError> {
+        let mut r = start(config)?;
+        let t = Instant::now();
+        while t.elapsed() < after {
+            if r.link.step(&mut r.parser, &mut r.writer)? {
+                break;
+            }
+        }
+        let screen = r.parser.screen().clone();
+        quit(&mut r)?;
+        Ok(screen)
+    }
+
+    /// Runs the viewer behind the link and times `config.presses` key presses.
+    pub fn run(config: &Config) -> Result<Report, LinkError> {
+        let mut r = start(config)?;
+        let Running {
+            writer,
+            link,
+            parser,
+            ..
+        } = &mut r;
+        let mut report = Report::default();
         let measure_from = Instant::now();
         let (delivered0, frames0) = (link.delivered, link.frames);
         let mut cull = false;
@@ -291,17 +389,17 @@ mod linux {
             // Let the link fill with spinning frames before each press.
             let settle = Instant::now();
             while settle.elapsed() < Duration::from_millis(700) {
-                link.step(&mut parser, &mut writer)?;
+                link.step(parser, writer)?;
             }
             writer.write_all(b"b")?;
             cull = !cull;
             let pressed = Instant::now();
             let mut seen = None;
             while pressed.elapsed() < config.timeout {
-                if link.step(&mut parser, &mut writer)? {
+                if link.step(parser, writer)? {
                     break;
                 }
-                if status_says_cull(&parser, config.rows) == cull {
+                if status_says_cull(parser, config.rows) == cull {
                     seen = Some(pressed.elapsed());
                     break;
                 }
@@ -312,17 +410,7 @@ mod linux {
         report.delivered_fps = (link.frames - frames0) as f64 / secs;
         report.bytes_per_second = (link.delivered - delivered0) as f64 / secs;
         report.max_buffered = link.max_buffered;
-        let _ = writer.write_all(b"q");
-        let quit = Instant::now();
-        while quit.elapsed() < Duration::from_secs(5) {
-            if link.step(&mut parser, &mut writer)? || child.try_wait()?.is_some() {
-                break;
-            }
-        }
-        if child.try_wait()?.is_none() {
-            let _ = child.kill();
-        }
-        let _ = child.wait();
+        quit(&mut r)?;
         Ok(report)
     }
 }

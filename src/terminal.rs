@@ -12,9 +12,11 @@ pub mod glyphs;
 pub mod input;
 pub mod locale;
 pub mod paint;
+pub mod palette;
 mod shaped;
 pub mod shapes;
 mod split;
 
 pub use color::{ColorMode, Rgb};
 pub use glyphs::{CellGlyph, GlyphMode};
+pub use palette::Palette;

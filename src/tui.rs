@@ -107,6 +107,8 @@ pub struct RunOptions {
     pub max_rate: Option<u64>,
     /// Pace frames by the terminal's answers.
     pub paced: bool,
+    /// Ask the terminal for its 16 colours (OSC 4) and fit 16-colour frames to them.
+    pub ask_palette: bool,
 }
 
 /// What wakes the loop.
@@ -233,6 +235,12 @@ pub fn run(mut app: App, options: RunOptions) -> Result<(), ViewError> {
     };
     let mut terminal = Terminal::new(link::LinkBackend::new(writer))?;
     terminal.clear()?;
+    if options.ask_palette {
+        // Answers come back as input, before the answer to the first frame's query.
+        terminal
+            .backend_mut()
+            .write_all(&crate::terminal::palette::query())?;
+    }
     app.fps.cap = options.fps.max(1) as f32;
     let mut pacer = Pacer::new(options.paced, options.max_rate);
     let mut parser = Parser::default();
@@ -273,6 +281,7 @@ fn settle(
                         pacer.answered(now);
                     }
                 }
+                // Palette answers and keys arriving now change nothing: leaving.
             }
             Ok(Wake::Signal(sig)) if ENDING.contains(&sig) => {
                 return Some(ViewError::Signal(sig));
@@ -421,6 +430,7 @@ fn main_loop(
         while let Some(input) = parser.next(now) {
             match input {
                 Input::DeviceAttributes => pacer.answered(now),
+                Input::PaletteColor(i, c) => dirty |= app.settings.terminal_color(i, c),
                 Input::Event(e) if e == ctrl_z => {
                     suspend(terminal, (wakes, parser), pacer)?;
                     resumed = true;

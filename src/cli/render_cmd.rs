@@ -223,6 +223,7 @@ fn text_frames(
             &vp.cells,
             usize::from(vp.cols),
             vp.settings.colors,
+            &vp.settings.palette,
             args.animate,
             &mut out,
         )?;

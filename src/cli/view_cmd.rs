@@ -24,9 +24,22 @@ pub struct LookArgs {
     /// Where the shape-fitted glyph modes (wedges, blocks, ascii) measure colour error.
     #[arg(long, value_enum, default_value_t = FitSpace::Srgb)]
     pub fit_space: FitSpace,
+    /// The 16 colours a 16-colour frame is fitted to: `auto` asks the terminal (xterm's
+    /// until it answers; `render` cannot ask and takes xterm's).
+    #[arg(long, value_enum, default_value_t = PaletteArg::Auto)]
+    pub palette: PaletteArg,
     /// Cell width / height (terminal cells are about twice as tall as wide).
     #[arg(long, default_value_t = 0.5, value_parser = parse_aspect)]
     pub cell_aspect: f32,
+}
+
+/// Where the 16 ANSI colours come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum PaletteArg {
+    /// Ask the terminal (OSC 4).
+    Auto,
+    /// xterm's default colours.
+    Xterm,
 }
 
 fn parse_aspect(s: &str) -> Result<f32, String> {
@@ -133,6 +146,7 @@ pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
             fps: args.fps,
             max_rate: args.max_rate,
             paced: !args.no_pacing,
+            ask_palette: args.look.palette == PaletteArg::Auto,
         },
     )?;
     Ok(())
@@ -144,6 +158,7 @@ pub fn write_ansi(vp: &Viewport, out: &mut impl Write) -> io::Result<()> {
         &vp.cells,
         usize::from(vp.cols),
         vp.settings.colors,
+        &vp.settings.palette,
         false,
         out,
     )

@@ -15,8 +15,9 @@ use super::reference::{self, ReferenceImages};
 use super::{FidelityError, save_png};
 use crate::scene::Scene;
 use crate::scene::render::SceneView;
+use crate::terminal::Palette;
 use crate::terminal::glyphs::FitSpace;
-use crate::terminal::paint::{self, Palette};
+use crate::terminal::paint;
 use crate::terminal::{ColorMode, GlyphMode};
 use crate::tui::viewport::{SceneState, ViewSettings, Viewport};
 
@@ -63,18 +64,21 @@ pub struct Outcome {
     pub notes: Vec<String>,
 }
 
-/// The palettes a frame of `source` at depth `colors` is painted with: xterm's always,
-/// and chafa's too where the frame's colours depend on it. chafa fits its 16- and
-/// 256-colour output to its own 16 ANSI colours ([`paint::CHAFA_ANSI16`]; at 256
-/// colours it picks indices 0–15 where one is nearest), termrast its 16-colour output
-/// to xterm's, so each program is shown on the palette it assumes and on the other's.
-/// termrast's 256-colour frames use only the cube and grey ramp (16–255), which the
-/// palettes share.
+/// The terminal palettes of the benchmark: xterm's, and chafa's own.
+pub const PALETTES: [Palette; 2] = [Palette::XTERM, Palette::CHAFA];
+
+/// The palettes a frame at depth `colors` is painted with: xterm's always, and chafa's
+/// too where the frame's colours depend on it (16 and 256 colours). chafa fits to its
+/// own 16 ANSI colours ([`Palette::CHAFA`]; at 256 colours it picks indices 0–15 where
+/// one is nearest) whatever the terminal has, so its frames are shown on the palette
+/// it assumes and on xterm's. termrast fits to the palette the terminal reports (at 256
+/// colours using 0–15 only then), so each of its indexed frames is fitted to the
+/// palette it is painted on ([`measure_view`] renders one per palette).
 #[must_use]
-pub fn palettes(source: Source, colors: ColorMode) -> &'static [Palette] {
-    match (source, colors) {
-        (_, ColorMode::Ansi16) | (Source::Chafa, ColorMode::Ansi256) => &Palette::ALL,
-        _ => &[Palette::Xterm],
+pub fn palettes(colors: ColorMode) -> &'static [Palette] {
+    match colors {
+        ColorMode::Ansi16 | ColorMode::Ansi256 => &PALETTES,
+        _ => &[Palette::XTERM],
     }
 }
 
@@ -86,6 +90,7 @@ pub fn encode(vp: &Viewport) -> std::io::Result<Vec<u8>> {
         &vp.cells,
         usize::from(vp.cols),
         vp.settings.colors,
+        &vp.settings.palette,
         false,
         &mut bytes,
     )?;
@@ -157,9 +162,10 @@ pub fn run(config: &Config) -> Result<Outcome, FidelityError> {
     }
     notes.push(
         "palette: the 16 ANSI colours the indexed frames are painted with; `xterm` is \
-         xterm's (what termrast fits to), `chafa` is chafa's own (what it fits to: \
-         colour 7 #c0c0c0, 8 #404040, dim colours at #80/#70); the rest of the 256 \
-         are the same in both"
+         xterm's, `chafa` is chafa's own (what it always fits to: colour 7 #c0c0c0, \
+         8 #404040, dim colours at #80/#70); termrast's 16-colour frames are fitted to \
+         the palette they are painted on, as the viewer fits to the palette the \
+         terminal reports; the rest of the 256 are the same in both"
             .into(),
     );
     notes.extend(size_notes(config, &measurements));
@@ -179,7 +185,7 @@ fn size_notes(config: &Config, ms: &[Measurement]) -> Vec<String> {
     for source in [Source::Termrast, Source::Chafa] {
         let of: Vec<_> = ms
             .iter()
-            .filter(|m| m.source == source && m.palette == Palette::Xterm)
+            .filter(|m| m.source == source && m.palette == Palette::XTERM)
             .collect();
         let wrong = |m: &&&Measurement| match source {
             Source::Termrast => m.printed.0 > grid.0 || m.printed.1 > grid.1,
@@ -225,25 +231,27 @@ struct Prepared {
     metric: metrics::Reference,
 }
 
-/// Scores one frame's bytes on each of its [`palettes`]: emulated, painted and
-/// compared with the reference.
+/// Scores one frame's bytes on each palette of `on`: emulated, painted and compared
+/// with the reference.
 fn measure(
     config: &Config,
     reference: &Prepared,
     bytes: &[u8],
     id: (&View, Source, &str, ColorMode),
+    on: &[Palette],
     out: &mut Vec<Measurement>,
 ) -> Result<(), FidelityError> {
     let (view, source, method, colors) = id;
     let printed = paint::printed_size(bytes, config.cols, config.rows)?;
-    for &palette in palettes(source, colors) {
-        let grid = paint::emulate_in(bytes, config.cols, config.rows, palette)?;
+    for &palette in on {
+        let grid = paint::emulate_in(bytes, config.cols, config.rows, &palette)?;
         let painted = paint::paint(&grid)?;
         let score = reference.metric.score(&painted.image)?;
         if let Some(dir) = &config.keep {
-            let on = match palette {
-                Palette::Xterm => String::new(),
-                p => format!("-{}-palette", p.name()),
+            let on = if palette == Palette::XTERM {
+                String::new()
+            } else {
+                format!("-{}-palette", palette.name)
             };
             let name = format!(
                 "{}-{}-{method}-{}{on}",
@@ -299,13 +307,18 @@ fn measure_view(
             FitSpace::Srgb => glyphs.name().to_string(),
             FitSpace::Linear => format!("{}-linear", glyphs.name()),
         };
-        for colors in ColorMode::ALL {
+        let depths = ColorMode::ALL
+            .into_iter()
+            .flat_map(|c| palettes(c).iter().map(move |p| (c, *p)));
+        for (colors, palette) in depths {
             let settings = ViewSettings {
                 glyphs,
                 colors,
                 angle: view.angle,
                 tilt: view.tilt,
                 fit_space,
+                // As the viewer has it once the terminal has answered.
+                palette: palette.reported(),
                 ..ViewSettings::default()
             };
             vp.render(&mut state, &settings, (cols, rows));
@@ -339,7 +352,14 @@ fn measure_view(
             };
             let bytes = encode(&vp).map_err(FidelityError::Encode)?;
             let id = (view, Source::Termrast, method.as_str(), colors);
-            measure(config, &reference, &bytes, id, &mut out.measurements)?;
+            measure(
+                config,
+                &reference,
+                &bytes,
+                id,
+                &[palette],
+                &mut out.measurements,
+            )?;
             prepared = Some(reference);
         }
     }
@@ -403,7 +423,8 @@ fn measure_chafa(
             match chafa.convert(&input.path, config.cols, config.rows, set, colors) {
                 Ok(bytes) => {
                     let id = (view, Source::Chafa, set, colors);
-                    measure(config, reference, &bytes, id, &mut out.measurements)?;
+                    let on = palettes(colors);
+                    measure(config, reference, &bytes, id, on, &mut out.measurements)?;
                 }
                 Err(e) => out.notes.push(format!("{}: {e}", view.name())),
             }
@@ -426,7 +447,7 @@ mod tests {
         let n = variants().count()
             * ColorMode::ALL
                 .iter()
-                .map(|&c| palettes(Source::Termrast, c).len())
+                .map(|&c| palettes(c).len())
                 .sum::<usize>();
         assert_eq!(o.measurements.len(), n);
         for m in &o.measurements {
@@ -442,42 +463,46 @@ mod tests {
             }
         }
         assert!(o.notes.iter().any(|n| n.contains("--no-chafa")));
-        // At 16 colours each frame is painted on both palettes: the same bytes, and
-        // termrast's frames (fitted to xterm's colours) score better on xterm's.
+        // At 16 colours termrast renders a frame for each palette, fitted to it and
+        // painted on it: the shape-fitted modes choose other glyphs and colours.
         let on = |p: Palette| {
             o.measurements
                 .iter()
                 .filter(move |m| m.colors == ColorMode::Ansi16 && m.palette == p)
         };
-        assert_eq!(on(Palette::Xterm).count(), variants().count());
-        for (x, c) in on(Palette::Xterm).zip(on(Palette::Chafa)) {
-            assert_eq!((&x.method, x.bytes), (&c.method, c.bytes));
-            assert!(x.score.psnr > c.score.psnr, "{x:?} {c:?}");
-        }
+        assert_eq!(on(Palette::XTERM).count(), variants().count());
+        assert_eq!(on(Palette::CHAFA).count(), variants().count());
+        let differ = on(Palette::XTERM)
+            .zip(on(Palette::CHAFA))
+            .filter(|(x, c)| {
+                assert_eq!(x.method, c.method);
+                x.score != c.score
+            })
+            .count();
+        assert!(differ >= 3, "{differ}");
     }
 
     #[test]
-    fn chafa_is_painted_on_its_own_palette_where_it_uses_one() {
-        for source in [Source::Termrast, Source::Chafa] {
-            assert_eq!(palettes(source, ColorMode::Truecolor), [Palette::Xterm]);
-            assert_eq!(palettes(source, ColorMode::None), [Palette::Xterm]);
-            assert_eq!(palettes(source, ColorMode::Ansi16), Palette::ALL);
-        }
-        assert_eq!(palettes(Source::Chafa, ColorMode::Ansi256), Palette::ALL);
-        assert_eq!(
-            palettes(Source::Termrast, ColorMode::Ansi256),
-            [Palette::Xterm]
-        );
-        // termrast's 256-colour frames never use the indices the palettes differ in.
+    fn indexed_frames_are_painted_on_every_palette() {
+        assert_eq!(palettes(ColorMode::Truecolor), [Palette::XTERM]);
+        assert_eq!(palettes(ColorMode::None), [Palette::XTERM]);
+        assert_eq!(palettes(ColorMode::Ansi16), PALETTES);
+        assert_eq!(palettes(ColorMode::Ansi256), PALETTES);
+        // termrast's 256-colour frames use the indices the palettes differ in only
+        // where the terminal reported its palette.
+        let mut low = 0;
         for i in 0..=255u8 {
-            let c = ColorMode::Ansi256.color([i, i / 2, 255 - i]);
-            let grey = ColorMode::Ansi256.color([i; 3]);
+            let c = ColorMode::Ansi256.color([i, i / 2, 255 - i], &Palette::XTERM);
+            let grey = ColorMode::Ansi256.color([i; 3], &Palette::XTERM);
             for c in [c, grey] {
                 assert!(
                     matches!(c, ratatui::style::Color::Indexed(n) if n >= 16),
                     "{c:?}"
                 );
             }
+            let reported = ColorMode::Ansi256.color([i; 3], &Palette::CHAFA.reported());
+            low += usize::from(matches!(reported, ratatui::style::Color::Indexed(n) if n < 16));
         }
+        assert!(low > 0);
     }
 }

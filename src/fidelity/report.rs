@@ -2,9 +2,10 @@
 
 use std::io::{self, Write};
 
+use super::bench::PALETTES;
 use super::bench::{Measurement, Source};
 use crate::terminal::ColorMode;
-use crate::terminal::paint::Palette;
+use crate::terminal::Palette;
 
 /// One row of the table: a source, method, colour depth and palette averaged over the
 /// views.
@@ -65,7 +66,7 @@ pub fn summarise(ms: &[Measurement]) -> Vec<Summary> {
         s.bytes /= n;
     }
     let depth = |c: ColorMode| ColorMode::ALL.iter().position(|&d| d == c);
-    let palette = |p: Palette| Palette::ALL.iter().position(|&q| q == p);
+    let palette = |p: Palette| PALETTES.iter().position(|&q| q == p);
     rows.sort_by_key(|s| {
         (
             depth(s.colors),
@@ -79,7 +80,7 @@ pub fn summarise(ms: &[Measurement]) -> Vec<Summary> {
 /// How the table names a row's palette: only the indexed depths have one.
 fn palette_name(s: &Summary) -> &'static str {
     match s.colors {
-        ColorMode::Ansi256 | ColorMode::Ansi16 => s.palette.name(),
+        ColorMode::Ansi256 | ColorMode::Ansi16 => s.palette.name,
         ColorMode::Truecolor | ColorMode::None => "-",
     }
 }
@@ -139,7 +140,7 @@ pub fn write_csv(out: &mut impl Write, ms: &[Measurement]) -> io::Result<()> {
             m.source.name(),
             m.method,
             m.colors.name(),
-            m.palette.name(),
+            m.palette.name,
             m.score.ssim,
             m.score.psnr,
             m.bytes,
@@ -162,7 +163,7 @@ mod tests {
             source,
             method: method.into(),
             colors,
-            palette: Palette::Xterm,
+            palette: Palette::XTERM,
             score: Score { ssim, psnr: 20.0 },
             bytes: 100,
             unpainted: 1,
@@ -205,10 +206,10 @@ mod tests {
             ..m("a", source, "quad", ColorMode::Ansi16, ssim)
         };
         let ms = [
-            on(Palette::Chafa, Source::Chafa, 0.9),
-            on(Palette::Xterm, Source::Chafa, 0.5),
-            on(Palette::Xterm, Source::Termrast, 0.7),
-            on(Palette::Chafa, Source::Termrast, 0.6),
+            on(Palette::CHAFA, Source::Chafa, 0.9),
+            on(Palette::XTERM, Source::Chafa, 0.5),
+            on(Palette::XTERM, Source::Termrast, 0.7),
+            on(Palette::CHAFA, Source::Termrast, 0.6),
             m("a", Source::Termrast, "quad", ColorMode::Truecolor, 0.8),
         ];
         let rows = summarise(&ms);
@@ -219,11 +220,11 @@ mod tests {
         assert_eq!(
             key,
             [
-                (ColorMode::Truecolor, Palette::Xterm, Source::Termrast),
-                (ColorMode::Ansi16, Palette::Xterm, Source::Termrast),
-                (ColorMode::Ansi16, Palette::Xterm, Source::Chafa),
-                (ColorMode::Ansi16, Palette::Chafa, Source::Termrast),
-                (ColorMode::Ansi16, Palette::Chafa, Source::Chafa),
+                (ColorMode::Truecolor, Palette::XTERM, Source::Termrast),
+                (ColorMode::Ansi16, Palette::XTERM, Source::Termrast),
+                (ColorMode::Ansi16, Palette::XTERM, Source::Chafa),
+                (ColorMode::Ansi16, Palette::CHAFA, Source::Termrast),
+                (ColorMode::Ansi16, Palette::CHAFA, Source::Chafa),
             ]
         );
         let mut table = Vec::new();

@@ -12,8 +12,8 @@ use std::io::{self, Write};
 
 use ratatui::style::Color;
 
-use super::ColorMode;
 use super::glyphs::CellGlyph;
+use super::{ColorMode, Palette};
 
 /// Writes the SGR parameters that set the foreground (`fg`) or background colour `c`
 /// in their shortest form (no `ESC [` or `m`): shared by every encoder.
@@ -51,17 +51,18 @@ fn set_colors(out: &mut Vec<u8>, cur: &mut (Color, Color), want: (Color, Color))
 }
 
 /// Encodes `rows` lines of `cols` cells (row-major) for a terminal of colour depth
-/// `colors`. With `erase`, each line ends by erasing the rest of the terminal's line,
+/// `colors` whose 16 colours are `palette`. With `erase`, each line ends by erasing the rest of the terminal's line,
 /// so the frame can be drawn over an earlier one (cursor-home animation).
 pub fn write_frame(
     cells: &[CellGlyph],
     cols: usize,
     colors: ColorMode,
+    palette: &Palette,
     erase: bool,
     out: &mut impl Write,
 ) -> io::Result<()> {
     let to = |c: Option<[u8; 3]>| match c {
-        Some(c) if colors != ColorMode::None => colors.color(c),
+        Some(c) if colors != ColorMode::None => colors.color(c, palette),
         _ => Color::Reset,
     };
     let mut buf = Vec::with_capacity(cells.len() * 4);
@@ -104,7 +105,7 @@ mod tests {
 
     fn encode(cells: &[CellGlyph], cols: usize, colors: ColorMode) -> String {
         let mut out = Vec::new();
-        write_frame(cells, cols, colors, false, &mut out).unwrap();
+        write_frame(cells, cols, colors, &Palette::XTERM, false, &mut out).unwrap();
         String::from_utf8(out).unwrap()
     }
 

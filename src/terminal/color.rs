@@ -2,6 +2,8 @@
 
 use ratatui::style::Color;
 
+use super::palette::Palette;
+
 /// An 8-bit RGB colour.
 pub type Rgb = [u8; 3];
 
@@ -67,19 +69,21 @@ impl ColorMode {
         }
     }
 
-    /// Whether two colours look the same in this mode (the same palette entry).
+    /// Whether two colours look the same in this mode (the same palette entry) on a
+    /// terminal whose 16 colours are `palette`.
     #[must_use]
-    pub fn same(self, a: Rgb, b: Rgb) -> bool {
-        a == b || (self != ColorMode::Truecolor && self.color(a) == self.color(b))
+    pub fn same(self, a: Rgb, b: Rgb, palette: &Palette) -> bool {
+        a == b || (self != ColorMode::Truecolor && self.color(a, palette) == self.color(b, palette))
     }
 
-    /// The ratatui colour for an RGB colour in this mode (`Reset` in `None`).
+    /// The ratatui colour for an RGB colour in this mode (`Reset` in `None`), the 16
+    /// colours being `palette`.
     #[must_use]
-    pub fn color(self, c: Rgb) -> Color {
+    pub fn color(self, c: Rgb, palette: &Palette) -> Color {
         match self {
             ColorMode::Truecolor => Color::Rgb(c[0], c[1], c[2]),
-            ColorMode::Ansi256 => Color::Indexed(nearest_256(c)),
-            ColorMode::Ansi16 => ANSI16[nearest(&ANSI16_RGB, c)],
+            ColorMode::Ansi256 => Color::Indexed(palette.nearest_256(c)),
+            ColorMode::Ansi16 => ANSI16[usize::from(palette.nearest(c))],
             ColorMode::None => Color::Reset,
         }
     }
@@ -143,26 +147,6 @@ pub fn to_srgb(l: f32) -> u8 {
     }
 }
 
-/// xterm's default RGB values of the 16 ANSI colours.
-const ANSI16_RGB: [Rgb; 16] = [
-    [0, 0, 0],
-    [205, 0, 0],
-    [0, 205, 0],
-    [205, 205, 0],
-    [0, 0, 238],
-    [205, 0, 205],
-    [0, 205, 205],
-    [229, 229, 229],
-    [127, 127, 127],
-    [255, 0, 0],
-    [0, 255, 0],
-    [255, 255, 0],
-    [92, 92, 255],
-    [255, 0, 255],
-    [0, 255, 255],
-    [255, 255, 255],
-];
-
 const ANSI16: [Color; 16] = [
     Color::Black,
     Color::Red,
@@ -192,12 +176,6 @@ fn dist2(a: Rgb, b: Rgb) -> i32 {
     (0..3)
         .map(|i| (i32::from(a[i]) - i32::from(b[i])).pow(2))
         .sum()
-}
-
-fn nearest(palette: &[Rgb], c: Rgb) -> usize {
-    (0..palette.len())
-        .min_by_key(|&i| dist2(palette[i], c))
-        .unwrap_or(0)
 }
 
 /// Nearest entry of the xterm 256-colour palette: the 6×6×6 cube (16–231) or the grey
@@ -248,7 +226,7 @@ const CUBE_LEVEL_OF: [u8; 256] = {
 #[must_use]
 pub fn indexed_rgb(i: u8) -> Rgb {
     match i {
-        0..=15 => ANSI16_RGB[usize::from(i)],
+        0..=15 => Palette::XTERM.ansi[usize::from(i)],
         16..=231 => {
             let c = i - 16;
             [c / 36, c / 6 % 6, c % 6].map(|l| CUBE_LEVELS[usize::from(l)])

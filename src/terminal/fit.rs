@@ -23,8 +23,10 @@ use std::sync::OnceLock;
 use super::shapes;
 
 mod lanes;
+mod palette;
 pub use lanes::fit_lanes;
 pub(super) use lanes::fit_lanes_on;
+pub use palette::{FitPalette, PaletteFit, fit_palette};
 
 /// Samples per cell across and down.
 pub const SX: usize = 4;

@@ -7,10 +7,12 @@
 //! ordered by luminance, where the summed squared colour error of the two groups is
 //! smallest; block modes draw the brighter group in the foreground, braille puts its
 //! dots on the smaller group (dots ink only a third of the cell, so the colour that
-//! covers the cell's area is the background). A cell of one colour is a space on that
+//! covers the cell's area is the background) in a colour strengthened so that a dot's
+//! sample looks like its group from a distance. A cell of one colour is a space on that
 //! background in every mode that has one; without colour, shading is carried by ink
 //! density.
 
+use super::Palette;
 use super::color::{ColorMode, Rgb, to_linear, to_srgb};
 use super::fit;
 pub use super::shaped::fit_cells8;
@@ -301,7 +303,8 @@ pub fn explain(mode: GlyphMode, samples: &[Sample], g: &CellGlyph) -> String {
         _ => {
             let on = g.pattern.count_ones();
             let rule = if mode == GlyphMode::Braille {
-                "the smaller group on the dots"
+                "the smaller group on the dots, their colour strengthened for the third \
+                 of a sample a dot inks"
             } else {
                 "the brighter group in fg"
             };
@@ -338,7 +341,7 @@ fn shade(l: f32) -> char {
 }
 
 /// Chooses the glyph and colours of a cell from its samples (`mode.dims()` of them)
-/// for a terminal of colour depth `colors`, the shape-fitted modes measuring error in
+/// for a terminal of colour depth `colors` with xterm's 16 colours, the shape-fitted modes measuring error in
 /// `space`. Without colour, block and braille modes carry shading by ordered dithering
 /// (a sample is drawn when its luminance exceeds its threshold), and the shape-fitted
 /// modes by ink density (in linear light, as ink blends).
@@ -349,12 +352,25 @@ pub fn fit_cell(
     colors: ColorMode,
     space: FitSpace,
 ) -> CellGlyph {
+    fit_cell_in(mode, samples, colors, space, &Palette::XTERM)
+}
+
+/// [`fit_cell`] for a terminal whose 16 colours are `palette`: in 16 colours the
+/// shape-fitted modes choose the glyph and two entries of it together.
+#[must_use]
+pub fn fit_cell_in(
+    mode: GlyphMode,
+    samples: &[Sample],
+    colors: ColorMode,
+    space: FitSpace,
+    palette: &Palette,
+) -> CellGlyph {
     if samples.iter().all(|s| !s.covered) {
         return CellGlyph::EMPTY;
     }
     let colorless = colors == ColorMode::None;
     if mode.is_shaped() {
-        return shape_cell(repertoire(mode), samples, colors, space);
+        return shape_cell(repertoire(mode), samples, colors, space, palette);
     }
     let uniform = samples.iter().all(|s| *s == samples[0]);
     if colorless {
@@ -422,14 +438,14 @@ pub fn fit_cell(
         }
         _ => fit_two_colours(mode, samples),
     };
-    merge_if_same(g, colors)
+    merge_if_same(g, colors, palette)
 }
 
 /// A cell whose two colours are one palette entry in this colour depth is a space on
 /// it: the same picture in fewer bytes.
-pub(super) fn merge_if_same(g: CellGlyph, colors: ColorMode) -> CellGlyph {
+pub(super) fn merge_if_same(g: CellGlyph, colors: ColorMode, palette: &Palette) -> CellGlyph {
     match (g.fg, g.bg) {
-        (Some(f), Some(b)) if colors.same(f, b) => CellGlyph {
+        (Some(f), Some(b)) if colors.same(f, b, palette) => CellGlyph {
             error: g.error,
             ..CellGlyph::uniform(b)
         },

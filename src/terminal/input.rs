@@ -5,7 +5,8 @@
 //! [`ESC_WAIT`] or the next read does not continue a sequence, and a sequence that has
 //! started (`ESC [`) waits up to [`SEQUENCE_WAIT`] for its end. Control characters keep their modifier (Ctrl-Q is
 //! not `q`). Replies to the Primary Device Attributes query (`CSI ? … c`) are told
-//! apart from keys, for pacing frames. Unknown sequences are dropped whole, and a
+//! apart from keys, for pacing frames, and so are the colours of OSC 4 replies (the
+//! terminal's palette, [`super::palette`]). Unknown sequences are dropped whole, and a
 //! sequence longer than [`MAX_SEQUENCE`] bytes is garbage and dropped, so pending
 //! input stays bounded.
 
@@ -31,6 +32,8 @@ pub enum Input {
     Event(Event),
     /// The terminal's answer to `CSI c` (Primary Device Attributes).
     DeviceAttributes,
+    /// The terminal's answer to an OSC 4 query: palette index and its colour.
+    PaletteColor(u8, [u8; 3]),
 }
 
 /// Bytes from the terminal, parsed as they arrive.
@@ -204,6 +207,28 @@ fn plain(buf: &[u8], alt: bool) -> Parsed {
     Parsed::Done(item, 1)
 }
 
+/// An operating system command (`ESC ]` already taken from `body`), ended by BEL or
+/// `ESC \`: an OSC 4 colour reply is an item, anything else is dropped whole (never
+/// read as keys).
+fn osc(body: &[u8]) -> Parsed {
+    let end = body.iter().enumerate().find_map(|(i, &b)| match b {
+        0x07 => Some((i, 1)),
+        0x1B => Some((i, 2)),
+        _ => None,
+    });
+    match end {
+        // `ESC` must be followed by `\`; its second byte may not have arrived yet.
+        Some((i, 2)) if body.get(i + 1).is_none() => Parsed::Incomplete,
+        Some((i, 2)) if body[i + 1] != b'\\' => Parsed::Done(None, 2 + i),
+        Some((i, len)) => {
+            let item =
+                super::palette::parse_reply(&body[..i]).map(|(n, c)| Input::PaletteColor(n, c));
+            Parsed::Done(item, 2 + i + len)
+        }
+        None => Parsed::Incomplete,
+    }
+}
+
 /// Parses the start of `buf` (not empty).
 fn parse(buf: &[u8]) -> Parsed {
     if buf[0] != 0x1B {
@@ -222,6 +247,7 @@ fn parse(buf: &[u8]) -> Parsed {
                 None => Parsed::Done(None, 2),
             }
         }
+        b']' => osc(&buf[2..]),
         b'O' => match buf.get(2) {
             None => Parsed::Incomplete,
             Some(&f) => {
@@ -313,6 +339,39 @@ mod tests {
 
     fn k(code: KeyCode, m: KeyModifiers) -> Input {
         key(code, m).unwrap()
+    }
+
+    #[test]
+    fn palette_replies_are_items_and_other_commands_are_not_keys() {
+        let t = Instant::now();
+        let mut p = Parser::default();
+        p.feed(
+            b"\x1b]4;1;rgb:cdcd/0000/0000\x1b\\\x1b]4;12;rgb:5c/5c/ff\x07",
+            t,
+        );
+        p.feed(b"\x1b]11;rgb:0000/0000/0000\x1b\\x\x1b]4;2;rgb:00", t);
+        assert_eq!(
+            all(&mut p, t),
+            [
+                Input::PaletteColor(1, [205, 0, 0]),
+                Input::PaletteColor(12, [92, 92, 255]),
+                k(KeyCode::Char('x'), KeyModifiers::NONE),
+            ]
+        );
+        // The rest of a reply split across reads, its terminator split too.
+        p.feed(b"00/cdcd/0000\x1b", t);
+        assert_eq!(all(&mut p, t), []);
+        p.feed(b"\\q", t);
+        assert_eq!(
+            all(&mut p, t),
+            [
+                Input::PaletteColor(2, [0, 205, 0]),
+                k(KeyCode::Char('q'), KeyModifiers::NONE),
+            ]
+        );
+        // A reply that never ends is dropped after its wait, not read as keys.
+        p.feed(b"\x1b]4;3;rgb:12/34", t);
+        assert_eq!(all(&mut p, t + SEQUENCE_WAIT), []);
     }
 
     #[test]

@@ -7,15 +7,16 @@
 //! ([`PaintCell`]) and painted at [`CELL_WIDTH`] × [`CELL_HEIGHT`] pixels with the
 //! glyph geometry of [`super::shapes::ink`], the one the glyph fit uses.
 //!
-//! Indexed colours are resolved with a [`Palette`]: xterm's (what termrast's viewer
-//! quantises to) or chafa's, which differ in the 16 ANSI colours only.
+//! Indexed colours are resolved with a [`Palette`] (xterm's, chafa's, or any other
+//! terminal's), which differ in the 16 ANSI colours only.
 
 use std::collections::HashMap;
 use std::num::NonZeroU16;
 
 use image::RgbImage;
 
-use super::color::{Rgb, indexed_rgb, to_linear, to_srgb};
+use super::color::{Rgb, to_linear, to_srgb};
+use super::palette::Palette;
 use super::shapes::ink;
 
 /// Pixels per cell across.
@@ -80,65 +81,7 @@ pub enum PaintError {
     Mismatch { cols: u16, rows: u16, len: usize },
 }
 
-/// The 16 ANSI colours chafa assumes a terminal has (`term_colors_256` in chafa's
-/// `chafa/internal/chafa-color.c`; the same values in libchafa 1.12.4's data): it
-/// picks indices 0–15 for `-c 16`, and also for `-c 256` where one is nearest, by these
-/// values. Its 6×6×6 cube and grey ramp (16–255) are xterm's.
-pub const CHAFA_ANSI16: [Rgb; 16] = [
-    [0x00, 0x00, 0x00],
-    [0x80, 0x00, 0x00],
-    [0x00, 0x70, 0x00],
-    [0x70, 0x70, 0x00],
-    [0x00, 0x00, 0x70],
-    [0x70, 0x00, 0x70],
-    [0x00, 0x70, 0x70],
-    [0xc0, 0xc0, 0xc0],
-    [0x40, 0x40, 0x40],
-    [0xff, 0x00, 0x00],
-    [0x00, 0xff, 0x00],
-    [0xff, 0xff, 0x00],
-    [0x00, 0x00, 0xff],
-    [0xff, 0x00, 0xff],
-    [0x00, 0xff, 0xff],
-    [0xff, 0xff, 0xff],
-];
-
-/// The RGB a terminal shows for palette indices. A real terminal's 16 ANSI colours are
-/// its own (or its theme's); the benchmark paints with the palette each program
-/// assumes, so that a program is not scored on a palette it did not fit to.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Palette {
-    /// xterm's defaults: what termrast's colour quantisation assumes
-    /// ([`indexed_rgb`]).
-    #[default]
-    Xterm,
-    /// xterm's cube and grey ramp with chafa's 16 ANSI colours ([`CHAFA_ANSI16`]).
-    Chafa,
-}
-
-impl Palette {
-    /// Every palette, xterm's first.
-    pub const ALL: [Palette; 2] = [Palette::Xterm, Palette::Chafa];
-
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Palette::Xterm => "xterm",
-            Palette::Chafa => "chafa",
-        }
-    }
-
-    /// The colour of index `i`.
-    #[must_use]
-    pub fn rgb(self, i: u8) -> Rgb {
-        match self {
-            Palette::Chafa if i < 16 => CHAFA_ANSI16[usize::from(i)],
-            _ => indexed_rgb(i),
-        }
-    }
-}
-
-fn vt_color(c: vt100::Color, default: Rgb, palette: Palette) -> Rgb {
+fn vt_color(c: vt100::Color, default: Rgb, palette: &Palette) -> Rgb {
     match c {
         vt100::Color::Default => default,
         vt100::Color::Idx(i) => palette.rgb(i),
@@ -149,7 +92,7 @@ fn vt_color(c: vt100::Color, default: Rgb, palette: Palette) -> Rgb {
 /// The cell as shown on xterm's palette (see [`resolve_in`]).
 #[must_use]
 pub fn resolve(cell: &vt100::Cell) -> PaintCell {
-    resolve_in(cell, Palette::Xterm)
+    resolve_in(cell, &Palette::XTERM)
 }
 
 /// The cell as shown: the first character of its contents (a blank for none or for
@@ -157,7 +100,7 @@ pub fn resolve(cell: &vt100::Cell) -> PaintCell {
 /// with the defaults filled in and indices looked up in `palette`, fg and bg swapped
 /// under inverse video.
 #[must_use]
-pub fn resolve_in(cell: &vt100::Cell, palette: Palette) -> PaintCell {
+pub fn resolve_in(cell: &vt100::Cell, palette: &Palette) -> PaintCell {
     let ch = if cell.is_wide_continuation() {
         ' '
     } else {
@@ -197,7 +140,7 @@ fn feed(p: &mut vt100::Parser, bytes: &[u8]) {
 /// What a terminal of `cols × rows` cells with xterm's palette shows after printing
 /// `bytes` (see [`emulate_in`]).
 pub fn emulate(bytes: &[u8], cols: u16, rows: u16) -> Result<CellGrid, PaintError> {
-    emulate_in(bytes, cols, rows, Palette::Xterm)
+    emulate_in(bytes, cols, rows, &Palette::XTERM)
 }
 
 /// What a terminal of `cols × rows` cells whose palette is `palette` shows after
@@ -211,7 +154,7 @@ pub fn emulate_in(
     bytes: &[u8],
     cols: u16,
     rows: u16,
-    palette: Palette,
+    palette: &Palette,
 ) -> Result<CellGrid, PaintError> {
     let mut p = parser(cols, rows)?;
     feed(&mut p, bytes);
@@ -443,19 +386,19 @@ mod tests {
     #[test]
     fn palettes_differ_in_the_ansi_colours_only() {
         // chafa's light grey (7) and dark grey (8), and its dim red, against xterm's.
-        assert_eq!(Palette::Chafa.rgb(7), [0xc0; 3]);
-        assert_eq!(Palette::Chafa.rgb(8), [0x40; 3]);
-        assert_eq!(Palette::Chafa.rgb(1), [0x80, 0, 0]);
-        assert_eq!(Palette::Xterm.rgb(7), [229; 3]);
-        assert_eq!(Palette::Xterm.rgb(8), [127; 3]);
+        assert_eq!(Palette::CHAFA.rgb(7), [0xc0; 3]);
+        assert_eq!(Palette::CHAFA.rgb(8), [0x40; 3]);
+        assert_eq!(Palette::CHAFA.rgb(1), [0x80, 0, 0]);
+        assert_eq!(Palette::XTERM.rgb(7), [229; 3]);
+        assert_eq!(Palette::XTERM.rgb(8), [127; 3]);
         let differ: Vec<u8> = (0..=255)
-            .filter(|&i| Palette::Chafa.rgb(i) != Palette::Xterm.rgb(i))
+            .filter(|&i| Palette::CHAFA.rgb(i) != Palette::XTERM.rgb(i))
             .collect();
         assert_eq!(differ, [1, 2, 3, 4, 5, 6, 7, 8, 12]);
         // The same bytes (SGR 37 and 100: colours 7 and 8; 38;5;1) on either terminal.
         let bytes = "\x1b[37;100mA\x1b[38;5;1;48;5;250mB".as_bytes();
-        let x = emulate_in(bytes, 2, 1, Palette::Xterm).unwrap();
-        let c = emulate_in(bytes, 2, 1, Palette::Chafa).unwrap();
+        let x = emulate_in(bytes, 2, 1, &Palette::XTERM).unwrap();
+        let c = emulate_in(bytes, 2, 1, &Palette::CHAFA).unwrap();
         assert_eq!((x.cells[0].fg, x.cells[0].bg), ([229; 3], [127; 3]));
         assert_eq!((c.cells[0].fg, c.cells[0].bg), ([0xc0; 3], [0x40; 3]));
         assert_eq!((x.cells[1].fg, c.cells[1].fg), ([205, 0, 0], [0x80, 0, 0]));

@@ -2,8 +2,9 @@
 //! fitted by [`super::fit`], one cell at a time or eight in SIMD lanes straight from
 //! the frame's rows, and the fit shown as a glyph and two colours.
 
-use super::color::{ColorMode, to_linear};
-use super::fit::{self, Repertoire};
+use super::Palette;
+use super::color::{ColorMode, Rgb, to_linear};
+use super::fit::{self, FitPalette, Repertoire};
 use super::glyphs::{
     CellGlyph, DEFAULT_FG_LEVEL, FitSpace, GlyphMode, Sample, linear_luminance, merge_if_same,
 };
@@ -25,12 +26,14 @@ fn covered(samples: &[Sample]) -> u32 {
         .fold(0, |m, (i, s)| m | u32::from(s.covered) << i)
 }
 
-/// Fits a cell of 4 × 8 samples with the shapes of `rep`.
+/// Fits a cell of 4 × 8 samples with the shapes of `rep`, the 16 colours (if
+/// `colors` has only those) being `palette`.
 pub(super) fn shape_cell(
     rep: &Repertoire,
     samples: &[Sample],
     colors: ColorMode,
     space: FitSpace,
+    palette: &Palette,
 ) -> CellGlyph {
     let mut x = [[0f32; 3]; fit::N];
     if colors == ColorMode::None {
@@ -48,17 +51,67 @@ pub(super) fn shape_cell(
     for (px, s) in x.iter_mut().zip(samples) {
         *px = s.rgb.map(|v| space.encode(v));
     }
-    glyph_of(&fit::fit(rep, &x), covered(samples), colors, space)
+    if colors == ColorMode::Ansi16 {
+        let pal = FitPalette::new(palette, |v| space.encode(v));
+        return palette_glyph(rep, &x, covered(samples), &pal);
+    }
+    glyph_of(&fit::fit(rep, &x), covered(samples), colors, space, palette)
+}
+
+/// The glyph and two entries of a 16-colour palette that fit samples `x` best (see
+/// [`fit::fit_palette`]); a side with no covered sample is the terminal's own
+/// background, as in [`glyph_of`].
+fn palette_glyph(
+    rep: &Repertoire,
+    x: &[[f32; 3]; fit::N],
+    covered: u32,
+    pal: &FitPalette,
+) -> CellGlyph {
+    let f = fit::fit_palette(rep, x, pal);
+    let (on, off) = (pal.rgb[usize::from(f.on)], pal.rgb[usize::from(f.off)]);
+    let Some(sh) = f.shape else {
+        return CellGlyph {
+            error: f.error,
+            ..CellGlyph::uniform(on)
+        };
+    };
+    let (ch, pattern, fg, bg) = show_sides(sh, covered, on, off);
+    CellGlyph {
+        ch,
+        fg: Some(fg),
+        bg,
+        pattern,
+        error: f.error,
+    }
+}
+
+/// The glyph, its pattern and colours for shape `sh` in `on` over `off`: where no
+/// covered sample is bare the background is left to the terminal, and where none is
+/// inked the inverse glyph (if any) puts the terminal's background on that side.
+fn show_sides(sh: &fit::Shape, covered: u32, on: Rgb, off: Rgb) -> (char, u32, Rgb, Option<Rgb>) {
+    let (inked, bare) = (0..fit::N)
+        .filter(|&i| covered >> i & 1 == 1)
+        .fold((false, false), |(i, b), k| {
+            (i || sh.weights[k] > 0.0, b || sh.weights[k] < 1.0)
+        });
+    if !bare {
+        (sh.ch, sh.mask, on, None)
+    } else if let (false, Some(inv)) = (inked, sh.inverse) {
+        (inv, !sh.mask, off, None)
+    } else {
+        (sh.ch, sh.mask, on, Some(off))
+    }
 }
 
 /// Fits up to 8 adjacent cells of a shape-fitted mode in colour, all at once, from the
 /// frame's sample rows: `rows[j]` is sample row `j` of the cell row from the first
 /// cell's first sample on (RGBA; alpha ≥ 128 is covered). Each of `out` gets
-/// [`fit_cell`]'s result for its cell.
+/// [`fit_cell_in`](super::glyphs::fit_cell_in)'s result for its cell.
 pub fn fit_cells8(
     mode: GlyphMode,
     colors: ColorMode,
     space: FitSpace,
+    palette: &Palette,
     rows: [&[[u8; 4]]; fit::SY],
     out: &mut [CellGlyph],
 ) {
@@ -66,10 +119,10 @@ pub fn fit_cells8(
     let n = out.len();
     let rep = repertoire(mode);
     #[cfg(target_arch = "x86_64")]
-    if n == 8 && crate::simd::Isa::Avx2.is_supported() {
+    if n == 8 && colors != ColorMode::Ansi16 && crate::simd::Isa::Avx2.is_supported() {
         // SAFETY: the CPU has the features the function is compiled for.
         let (covered, fits) = unsafe { gather_fit8_avx2(rep, space, rows) };
-        show(out, &covered, fits.as_ref(), colors, space);
+        show(out, &covered, fits.as_ref(), colors, space, palette);
         return;
     }
     // Coverage first: most batches of the background end here.
@@ -89,6 +142,22 @@ pub fn fit_cells8(
         return;
     }
     let table = space.table();
+    if colors == ColorMode::Ansi16 {
+        // The palette fit searches every pair of entries per glyph: one cell at a time.
+        let pal = FitPalette::new(palette, |v| space.encode(v));
+        for (l, g) in out.iter_mut().enumerate() {
+            *g = if covered[l] == 0 {
+                CellGlyph::EMPTY
+            } else {
+                let x = std::array::from_fn(|k| {
+                    let p = rows[k / fit::SX][l * fit::SX + k % fit::SX];
+                    [0, 1, 2].map(|c| table[usize::from(p[c])])
+                });
+                palette_glyph(rep, &x, covered[l], &pal)
+            };
+        }
+        return;
+    }
     let lanes: [[[f32; 8]; 3]; fit::N] = std::array::from_fn(|k| {
         let (i, j) = (k % fit::SX, k / fit::SX);
         std::array::from_fn(|c| {
@@ -107,6 +176,7 @@ pub fn fit_cells8(
         Some(&fit::fit_lanes(rep, &lanes)),
         colors,
         space,
+        palette,
     );
 }
 
@@ -117,6 +187,7 @@ fn show(
     fits: Option<&[fit::Fit; 8]>,
     colors: ColorMode,
     space: FitSpace,
+    palette: &Palette,
 ) {
     let Some(fits) = fits else {
         out.fill(CellGlyph::EMPTY);
@@ -126,7 +197,7 @@ fn show(
         *g = if covered[l] == 0 {
             CellGlyph::EMPTY
         } else {
-            glyph_of(&fits[l], covered[l], colors, space)
+            glyph_of(&fits[l], covered[l], colors, space, palette)
         };
     }
 }
@@ -217,7 +288,13 @@ unsafe fn gather_fit8_avx2<'r>(
 
 /// The glyph and colours that show a fit: a side with no covered sample is the
 /// terminal's own background (with the complementary glyph if that puts it there).
-fn glyph_of(f: &fit::Fit, covered: u32, colors: ColorMode, space: FitSpace) -> CellGlyph {
+fn glyph_of(
+    f: &fit::Fit,
+    covered: u32,
+    colors: ColorMode,
+    space: FitSpace,
+    palette: &Palette,
+) -> CellGlyph {
     let srgb = |c: [f32; 3]| c.map(|v| space.decode(v));
     let Some(sh) = f.shape else {
         return CellGlyph {
@@ -225,18 +302,7 @@ fn glyph_of(f: &fit::Fit, covered: u32, colors: ColorMode, space: FitSpace) -> C
             ..CellGlyph::uniform(srgb(f.on))
         };
     };
-    let (inked, bare) = (0..fit::N)
-        .filter(|&i| covered >> i & 1 == 1)
-        .fold((false, false), |(i, b), k| {
-            (i || sh.weights[k] > 0.0, b || sh.weights[k] < 1.0)
-        });
-    let (ch, pattern, fg, bg) = if !bare {
-        (sh.ch, sh.mask, srgb(f.on), None)
-    } else if let (false, Some(inv)) = (inked, sh.inverse) {
-        (inv, !sh.mask, srgb(f.off), None)
-    } else {
-        (sh.ch, sh.mask, srgb(f.on), Some(srgb(f.off)))
-    };
+    let (ch, pattern, fg, bg) = show_sides(sh, covered, srgb(f.on), srgb(f.off));
     merge_if_same(
         CellGlyph {
             ch,
@@ -246,6 +312,7 @@ fn glyph_of(f: &fit::Fit, covered: u32, colors: ColorMode, space: FitSpace) -> C
             error: f.error,
         },
         colors,
+        palette,
     )
 }
 
@@ -286,7 +353,14 @@ mod tests {
                     let rows: [&[[u8; 4]]; fit::SY] =
                         std::array::from_fn(|j| &frame[j * w..j * w + n * fit::SX]);
                     let mut out = [CellGlyph::default(); 8];
-                    fit_cells8(mode, ColorMode::Truecolor, space, rows, &mut out[..n]);
+                    fit_cells8(
+                        mode,
+                        ColorMode::Truecolor,
+                        space,
+                        &Palette::XTERM,
+                        rows,
+                        &mut out[..n],
+                    );
                     for (l, got) in out[..n].iter().enumerate() {
                         let samples: Vec<Sample> = (0..fit::N)
                             .map(|k| {

@@ -142,6 +142,13 @@ pub(super) fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph 
     } else {
         mean(samples, rest.iter().copied())
     };
+    // A dot inks a third of its sample: its colour is strengthened so that the sample
+    // looks like its group's mean from a distance.
+    let fg = if mode == GlyphMode::Braille {
+        fg.map(|f| dot_colour(f, bg.unwrap_or([0; 3])))
+    } else {
+        fg
+    };
     CellGlyph {
         ch: mode.pattern_glyph(pattern),
         fg,
@@ -149,6 +156,19 @@ pub(super) fn fit_two_colours(mode: GlyphMode, samples: &[Sample]) -> CellGlyph 
         pattern,
         error,
     }
+}
+
+/// The dot colour that makes a braille sample, a dot of a third of its area on `bg`,
+/// look like `want` (in linear light, as the eye mixes them), as near as the
+/// displayable range allows.
+fn dot_colour(want: Rgb, bg: Rgb) -> Rgb {
+    use super::color::{to_linear, to_srgb};
+    let mut out = [0u8; 3];
+    for c in 0..3 {
+        let (w, b) = (to_linear(want[c]), to_linear(bg[c]));
+        out[c] = to_srgb(b + 3.0 * (w - b));
+    }
+    out
 }
 
 fn mean(samples: &[Sample], idx: impl Iterator<Item = usize> + Clone) -> Option<Rgb> {

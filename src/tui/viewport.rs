@@ -14,8 +14,8 @@ use crate::render::wire::WireCount;
 use crate::scene::Scene;
 use crate::scene::render::{SceneFrame, SceneView};
 use crate::terminal::fit;
-use crate::terminal::glyphs::{FitSpace, Sample, fit_cell, fit_cells8};
-use crate::terminal::{CellGlyph, ColorMode, GlyphMode};
+use crate::terminal::glyphs::{FitSpace, Sample, fit_cell_in, fit_cells8};
+use crate::terminal::{CellGlyph, ColorMode, GlyphMode, Palette};
 
 /// What the viewer shows and how; how the scene is drawn (filled or as edges,
 /// culled) is the scene's own ([`Scene::set_mode`], [`Scene::set_cull`]).
@@ -33,6 +33,8 @@ pub struct ViewSettings {
     pub tilt: f32,
     /// Where the shape-fitted modes measure colour error.
     pub fit_space: FitSpace,
+    /// The terminal's 16 colours (xterm's unless it said otherwise).
+    pub palette: Palette,
 }
 
 impl Default for ViewSettings {
@@ -45,6 +47,7 @@ impl Default for ViewSettings {
             angle: 0.6,
             tilt: 0.25,
             fit_space: FitSpace::Srgb,
+            palette: Palette::XTERM,
         }
     }
 }
@@ -62,6 +65,15 @@ impl ViewSettings {
             zoom: self.zoom,
             pixel_aspect: self.cell_aspect * sy as f32 / sx as f32,
         }
+    }
+
+    /// Takes colour `i` of the terminal's palette as it reported it; whether that
+    /// changes what a 16-colour frame looks like.
+    pub fn terminal_color(&mut self, i: u8, c: crate::terminal::Rgb) -> bool {
+        let p = self.palette.with(i, c);
+        let changed = p != self.palette;
+        self.palette = p;
+        changed && matches!(self.colors, ColorMode::Ansi16 | ColorMode::Ansi256)
     }
 }
 
@@ -209,10 +221,11 @@ impl Viewport {
 
     /// Fits cell row `cy` into `out`.
     fn fit_row(&self, cy: usize, out: &mut [CellGlyph]) {
-        let (mode, colors, space) = (
+        let (mode, colors, space, palette) = (
             self.settings.glyphs,
             self.settings.colors,
             self.settings.fit_space,
+            &self.settings.palette,
         );
         let cols = out.len();
         if mode.dims() == (fit::SX as u32, fit::SY as u32) && colors != ColorMode::None {
@@ -227,7 +240,14 @@ impl Viewport {
                     let at = start + j * w;
                     &self.color.0[at..at + n * fit::SX]
                 });
-                fit_cells8(mode, colors, space, sample_rows, &mut out[x0..x0 + n]);
+                fit_cells8(
+                    mode,
+                    colors,
+                    space,
+                    palette,
+                    sample_rows,
+                    &mut out[x0..x0 + n],
+                );
             }
         } else {
             // One sample buffer filled in place: returning it by value per cell cost a
@@ -235,7 +255,7 @@ impl Viewport {
             let mut s = [Sample::default(); GlyphMode::MAX_SAMPLES];
             for (cx, cell) in out.iter_mut().enumerate() {
                 let n = self.samples_into(cx as u16, cy as u16, &mut s);
-                *cell = fit_cell(mode, &s[..n], colors, space);
+                *cell = fit_cell_in(mode, &s[..n], colors, space, palette);
             }
         }
     }
@@ -311,9 +331,9 @@ impl Viewport {
 
 impl Widget for &Viewport {
     fn render(self, area: Rect, buf: &mut Buffer) {
-        let colors = self.settings.colors;
+        let (colors, palette) = (self.settings.colors, &self.settings.palette);
         let color = |c: Option<[u8; 3]>| match (c, colors) {
-            (Some(c), m) if m != ColorMode::None => m.color(c),
+            (Some(c), m) if m != ColorMode::None => m.color(c, palette),
             _ => Color::Reset,
         };
         for cy in 0..self.rows.min(area.height) {

@@ -193,7 +193,9 @@ fn braille_dots_go_on_the_smaller_group() {
         ColorMode::Truecolor,
         FitSpace::Srgb,
     );
-    assert_eq!((g.ch, g.fg, g.bg), ('⢀', Some([30; 3]), Some([240; 3])));
+    // The dot inks a third of its sample, so its colour is as much darker than the
+    // background as it can be (black): the sample still looks lighter than 30.
+    assert_eq!((g.ch, g.fg, g.bg), ('⢀', Some([0; 3]), Some([240; 3])));
     // A bright edge over the empty background: the covered samples stay dots whenever
     // they are the smaller group.
     let off = Sample::default();
@@ -203,7 +205,24 @@ fn braille_dots_go_on_the_smaller_group() {
         ColorMode::Truecolor,
         FitSpace::Srgb,
     );
-    assert_eq!((g.fg, g.bg), (Some([240; 3]), None));
+    // Dots of 240 over black would show at a third: they are drawn at full white.
+    assert_eq!((g.fg, g.bg), (Some([255; 3]), None));
+    // A dot that needs less than three times its strength gets exactly that, in linear
+    // light: a third of the dot colour's light over the black between.
+    let dim = Sample {
+        rgb: [60; 3],
+        covered: true,
+    };
+    let g = fit_cell(
+        GlyphMode::Braille,
+        &[dim, off, off, off, off, off, off, off],
+        ColorMode::Truecolor,
+        FitSpace::Srgb,
+    );
+    let fg = g.fg.unwrap()[0];
+    let shown = termrast::terminal::color::to_linear(fg) / 3.0;
+    let want = termrast::terminal::color::to_linear(60);
+    assert!((shown - want).abs() < 0.002, "{fg}: {shown} against {want}");
 }
 
 /// The frame as a terminal shows it: the ANSI text through a terminal emulator.

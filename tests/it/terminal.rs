@@ -5,7 +5,7 @@ use ratatui::backend::TestBackend;
 use termrast::render::wire::Mode;
 use termrast::scene::Scene;
 use termrast::terminal::glyphs::{FitSpace, Sample, braille, fit_cell, sextant};
-use termrast::terminal::{ColorMode, GlyphMode};
+use termrast::terminal::{ColorMode, GlyphMode, Palette};
 use termrast::tui::app::App;
 use termrast::tui::inspector::{inspector_text, line_at_sample, line_text};
 use termrast::tui::viewport::ViewSettings;
@@ -168,16 +168,23 @@ fn colour_detection_table() {
         assert_eq!(got, *want, "{env:?}");
     }
     assert_eq!(
-        ColorMode::Ansi256.color([255, 0, 0]),
+        ColorMode::Ansi256.color([255, 0, 0], &Palette::XTERM),
         ratatui::style::Color::Indexed(196)
     );
     assert_eq!(
-        ColorMode::Ansi256.color([128, 128, 128]),
+        ColorMode::Ansi256.color([128, 128, 128], &Palette::XTERM),
         ratatui::style::Color::Indexed(244)
     );
     assert_eq!(
-        ColorMode::Ansi16.color([250, 250, 250]),
+        ColorMode::Ansi16.color([250, 250, 250], &Palette::XTERM),
         ratatui::style::Color::White
+    );
+    // On a palette whose white is elsewhere, the nearest entry is that one.
+    let mut swapped = Palette::XTERM;
+    swapped.ansi.swap(9, 15);
+    assert_eq!(
+        ColorMode::Ansi16.color([250, 250, 250], &swapped),
+        ratatui::style::Color::LightRed
     );
 }
 

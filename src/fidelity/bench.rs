@@ -163,9 +163,9 @@ pub fn run(config: &Config) -> Result<Outcome, FidelityError> {
     notes.push(
         "palette: the 16 ANSI colours the indexed frames are painted with; `xterm` is \
          xterm's, `chafa` is chafa's own (what it always fits to: colour 7 #c0c0c0, \
-         8 #404040, dim colours at #80/#70); termrast's 16-colour frames are fitted to \
-         the palette they are painted on, as the viewer fits to the palette the \
-         terminal reports; the rest of the 256 are the same in both"
+         8 #404040, dim colours at #80/#70); termrast's 16- and 256-colour frames are \
+         fitted to the palette they are painted on, as the viewer fits to the palette \
+         the terminal reports; the rest of the 256 are the same in both"
             .into(),
     );
     notes.extend(size_notes(config, &measurements));

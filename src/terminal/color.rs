@@ -101,9 +101,9 @@ pub fn to_linear(v: u8) -> f32 {
 #[must_use]
 pub fn oklab(c: Rgb) -> [f32; 3] {
     let [r, g, b] = c.map(to_linear);
-    let l = (0.412_221_46 * r + 0.536_332_55 * g + 0.051_445_995 * b).cbrt();
-    let m = (0.211_903_5 * r + 0.680_699_5 * g + 0.107_396_96 * b).cbrt();
-    let s = (0.088_302_46 * r + 0.281_718_85 * g + 0.629_978_7 * b).cbrt();
+    let l = cbrt(0.412_221_46 * r + 0.536_332_55 * g + 0.051_445_995 * b);
+    let m = cbrt(0.211_903_5 * r + 0.680_699_5 * g + 0.107_396_96 * b);
+    let s = cbrt(0.088_302_46 * r + 0.281_718_85 * g + 0.629_978_7 * b);
     [
         0.210_454_26 * l + 0.793_617_8 * m - 0.004_072_047 * s,
         1.977_998_5 * l - 2.428_592_2 * m + 0.450_593_7 * s,
@@ -111,11 +111,68 @@ pub fn oklab(c: Rgb) -> [f32; 3] {
     ]
 }
 
+/// The cube root of `x ≥ 0`, to f32 precision: a first guess from the exponent bits and
+/// two Halley steps (the library's `cbrtf` was a tenth of a viewer frame, through the
+/// cell cache's colour distances).
+#[inline]
+fn cbrt(x: f32) -> f32 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    let mut y = f32::from_bits(x.to_bits() / 3 + 709_921_077);
+    for _ in 0..2 {
+        let y3 = y * y * y;
+        y *= (y3 + 2.0 * x) / (2.0 * y3 + x);
+    }
+    y
+}
+
 /// Perceived difference of two colours: Euclidean distance in [`oklab`].
 #[must_use]
 pub fn delta_e(a: Rgb, b: Rgb) -> f32 {
     let (p, q) = (oklab(a), oklab(b));
     ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+}
+
+/// [`oklab`] of recently seen colours, in a direct-mapped table: the cell cache compares
+/// a few colours per changed cell every frame, and a frame has few distinct colours.
+#[derive(Clone, Debug)]
+pub struct OklabCache {
+    /// `rgb | 1 << 24` of each slot's colour (0: empty).
+    keys: Box<[u32]>,
+    labs: Box<[[f32; 3]]>,
+}
+
+impl Default for OklabCache {
+    fn default() -> Self {
+        Self {
+            keys: vec![0; Self::SLOTS].into_boxed_slice(),
+            labs: vec![[0.0; 3]; Self::SLOTS].into_boxed_slice(),
+        }
+    }
+}
+
+impl OklabCache {
+    const SLOTS: usize = 4096;
+
+    /// [`oklab`] of `c`.
+    #[inline]
+    pub fn lab(&mut self, c: Rgb) -> [f32; 3] {
+        let key = u32::from(c[0]) << 16 | u32::from(c[1]) << 8 | u32::from(c[2]) | 1 << 24;
+        let slot = (key.wrapping_mul(0x9E37_79B1) >> 20) as usize;
+        if self.keys[slot] != key {
+            self.keys[slot] = key;
+            self.labs[slot] = oklab(c);
+        }
+        self.labs[slot]
+    }
+
+    /// [`delta_e`] of two colours.
+    #[inline]
+    pub fn delta_e(&mut self, a: Rgb, b: Rgb) -> f32 {
+        let (p, q) = (self.lab(a), self.lab(b));
+        ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+    }
 }
 
 fn linear_table() -> &'static [f32; 256] {
@@ -297,6 +354,30 @@ mod tests {
         }
         let rms = ((total / n) as f64 / 3.0).sqrt();
         assert!(rms < 20.0, "rms channel error {rms}");
+    }
+
+    #[test]
+    fn the_cache_gives_the_same_distances() {
+        let mut cache = OklabCache::default();
+        for i in 0..20_000u32 {
+            let c = |k: u32| {
+                let v = (i.wrapping_mul(2_654_435_761) >> k) as u8;
+                [v, v.wrapping_mul(7), v.wrapping_add(i as u8)]
+            };
+            let (a, b) = (c(3), c(11));
+            assert_eq!(cache.delta_e(a, b).to_bits(), delta_e(a, b).to_bits());
+        }
+    }
+
+    #[test]
+    fn the_cube_root_is_the_library_s() {
+        for k in 0..=20_000 {
+            let x = k as f32 / 20_000.0;
+            let (got, want) = (cbrt(x), x.cbrt());
+            assert!((got - want).abs() <= 2e-7, "{x}: {got} {want}");
+        }
+        assert_eq!(cbrt(0.0), 0.0);
+        assert_eq!(cbrt(-1.0), 0.0);
     }
 
     #[test]

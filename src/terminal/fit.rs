@@ -87,6 +87,9 @@ pub struct Shape {
     pub weights: [f32; N],
     /// The samples inked at least half (bit `j·4 + i` for sample (i, j)).
     pub mask: u32,
+    /// The samples it inks at all, and those it does not ink wholly.
+    pub(super) touched: u32,
+    pub(super) partial: u32,
     terms: [Term; MAX_TERMS],
     n_terms: usize,
     /// `Σα`, `Σα²` and `1 / (nΣα² − (Σα)²)`.
@@ -133,6 +136,8 @@ impl Shape {
             inverse: None,
             weights: w,
             mask: (0..N).fold(0, |m, k| m | u32::from(w[k] >= 0.5) << k),
+            touched: (0..N).fold(0, |m, k| m | u32::from(w[k] > 0.0) << k),
+            partial: (0..N).fold(0, |m, k| m | u32::from(w[k] < 1.0) << k),
             terms,
             n_terms,
             a,

@@ -89,11 +89,7 @@ fn palette_glyph(
 /// covered sample is bare the background is left to the terminal, and where none is
 /// inked the inverse glyph (if any) puts the terminal's background on that side.
 fn show_sides(sh: &fit::Shape, covered: u32, on: Rgb, off: Rgb) -> (char, u32, Rgb, Option<Rgb>) {
-    let (inked, bare) = (0..fit::N)
-        .filter(|&i| covered >> i & 1 == 1)
-        .fold((false, false), |(i, b), k| {
-            (i || sh.weights[k] > 0.0, b || sh.weights[k] < 1.0)
-        });
+    let (inked, bare) = (covered & sh.touched != 0, covered & sh.partial != 0);
     if !bare {
         (sh.ch, sh.mask, on, None)
     } else if let (false, Some(inv)) = (inked, sh.inverse) {

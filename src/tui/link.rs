@@ -25,7 +25,9 @@ use ratatui::buffer::Cell;
 use ratatui::layout::{Position, Rect, Size};
 use ratatui::style::{Color, Modifier};
 
-use crate::terminal::color::{Rgb, delta_e, indexed_rgb, nearest_256};
+use std::cell::RefCell;
+
+use crate::terminal::color::{OklabCache, Rgb, indexed_rgb, nearest_256};
 
 /// How far (OKLab distance) a changed cell's colour may stray from the true frame.
 pub const DELTA_E: f32 = 0.04;
@@ -74,6 +76,8 @@ pub struct LinkBackend<W: Write> {
     candidates: Vec<(f32, u32)>,
     /// Mean bytes per bulk cell sent, to fit the budget.
     cell_bytes: f32,
+    /// OKLab of the colours compared lately.
+    lab: RefCell<OklabCache>,
 }
 
 impl<W: Write> LinkBackend<W> {
@@ -105,6 +109,7 @@ impl<W: Write> LinkBackend<W> {
             budget: None,
             candidates: Vec::new(),
             cell_bytes: 12.0,
+            lab: RefCell::default(),
         };
         let s = b.size().unwrap_or(Size::new(80, 24));
         b.reset(s);
@@ -132,14 +137,25 @@ impl<W: Write> LinkBackend<W> {
         self.hidden = None;
     }
 
+    /// OKLab distance of two colours; 0 when equal, 1 (far) when either has no fixed
+    /// value.
+    fn distance(&self, a: Color, b: Color) -> f32 {
+        if a == b {
+            return 0.0;
+        }
+        match (fixed_rgb(a), fixed_rgb(b)) {
+            (Some(a), Some(b)) => self.lab.borrow_mut().delta_e(a, b),
+            _ => 1.0,
+        }
+    }
+
     /// Whether the shown cell `s` stands for the wanted `w` closely enough: exactly,
     /// or within the threshold if `approx`.
     fn close_enough(&self, s: &Cell, w: &Cell, approx: bool) -> bool {
         if s.symbol() != w.symbol() || s.modifier != w.modifier {
             return false;
         }
-        let near =
-            |a: Color, b: Color| a == b || (approx && color_distance(a, b) <= self.threshold);
+        let near = |a: Color, b: Color| a == b || (approx && self.distance(a, b) <= self.threshold);
         let (fg, bg) = shows(w);
         (!fg || near(s.fg, w.fg)) && (!bg || near(s.bg, w.bg))
     }
@@ -149,9 +165,9 @@ impl<W: Write> LinkBackend<W> {
     fn visibility(&self, i: usize) -> f32 {
         let (w, s) = (&self.wanted[i], &self.shown[i]);
         if s.symbol() != w.symbol() || s.modifier != w.modifier {
-            return 1.0 + color_distance(w.fg, w.bg).min(1.0);
+            return 1.0 + self.distance(w.fg, w.bg).min(1.0);
         }
-        color_distance(s.fg, w.fg).max(color_distance(s.bg, w.bg))
+        self.distance(s.fg, w.fg).max(self.distance(s.bg, w.bg))
     }
 
     /// Whether cell `i` must be sent.
@@ -229,7 +245,7 @@ impl<W: Write> LinkBackend<W> {
         if let Some(pen) = self.pen.filter(|p| p.modifier == w.modifier) {
             let (fg, bg) = shows(&w);
             let near =
-                |a: Color, b: Color| self.changed[i] && color_distance(a, b) <= self.threshold;
+                |a: Color, b: Color| self.changed[i] && self.distance(a, b) <= self.threshold;
             if !fg || near(pen.fg, w.fg) {
                 w.fg = pen.fg;
             }
@@ -242,7 +258,7 @@ impl<W: Write> LinkBackend<W> {
             for c in [&mut w.fg, &mut w.bg] {
                 if let Color::Rgb(r, g, b) = *c {
                     let n = nearest_256([r, g, b]);
-                    if delta_e(indexed_rgb(n), [r, g, b]) <= self.threshold {
+                    if self.lab.borrow_mut().delta_e(indexed_rgb(n), [r, g, b]) <= self.threshold {
                         *c = Color::Indexed(n);
                     }
                 }
@@ -344,17 +360,6 @@ fn fixed_rgb(c: Color) -> Option<Rgb> {
         Color::Rgb(r, g, b) => Some([r, g, b]),
         Color::Indexed(i) if i >= 16 => Some(indexed_rgb(i)),
         _ => None,
-    }
-}
-
-/// OKLab distance of two colours; 0 when equal, 1 (far) when either has no fixed value.
-fn color_distance(a: Color, b: Color) -> f32 {
-    if a == b {
-        return 0.0;
-    }
-    match (fixed_rgb(a), fixed_rgb(b)) {
-        (Some(a), Some(b)) => delta_e(a, b),
-        _ => 1.0,
     }
 }
 

@@ -8,7 +8,7 @@ use std::rc::Rc;
 
 use criterion::{BenchmarkId, Criterion, criterion_group};
 use ratatui::Terminal;
-use termrast::cli::view_cmd::load_model;
+use termrast::scene::Scene;
 use termrast::terminal::{ColorMode, GlyphMode};
 use termrast::tui::Counting;
 use termrast::tui::app::App;
@@ -31,7 +31,7 @@ fn bench(c: &mut Criterion) {
                 colors,
                 ..ViewSettings::default()
             };
-            let mut app = App::new(load_model(spec).expect("model"), settings);
+            let mut app = App::new(Scene::for_model(spec).expect("model"), settings);
             let bytes = Rc::new(Cell::new(0u64));
             let sink = Counting {
                 inner: io::sink(),
@@ -84,7 +84,7 @@ fn breakdown() {
             colors: ColorMode::Truecolor,
             ..ViewSettings::default()
         };
-        let mut app = App::new(load_model("bunny").expect("model"), settings);
+        let mut app = App::new(Scene::for_model("bunny").expect("model"), settings);
         let sink = Counting {
             inner: io::sink(),
             bytes: Rc::new(Cell::new(0u64)),
@@ -107,7 +107,7 @@ fn breakdown() {
             term.draw(|f| app.draw(f)).expect("draw");
             let all = t0.elapsed();
             let vp = &app.viewport;
-            let [a, b] = vp.frame.timing;
+            let [a, b] = app.scene.frame.timing;
             total.push(all);
             tf.push(a);
             rs.push(b);

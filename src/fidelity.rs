@@ -35,7 +35,7 @@ pub enum FidelityError {
     #[error("there are no views to measure")]
     NoViews,
     #[error(transparent)]
-    Mesh(#[from] crate::mesh::MeshError),
+    Scene(#[from] crate::scene::SceneError),
     #[error(transparent)]
     Paint(#[from] crate::terminal::paint::PaintError),
     #[error(transparent)]

@@ -42,6 +42,7 @@ pub mod file;
 pub mod plan;
 pub mod render;
 pub mod texture;
+mod topology;
 
 use std::path::{Path, PathBuf};
 
@@ -50,9 +51,10 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 use self::file::{EffectsFile, LightKind, Lighting, MaterialFile, TextureMode};
 use self::plan::Plan;
 use self::texture::Texture;
+use self::topology::Topology;
 use crate::camera::Camera;
 use crate::mesh::{Mesh, MeshError};
-use crate::render::wire::unique_edges;
+use crate::render::wire::Mode;
 
 /// `image = "checker"`: a built-in checkerboard texture instead of a file.
 pub const BUILTIN_CHECKER: &str = "checker";
@@ -71,6 +73,9 @@ pub enum SceneError {
         line: Option<usize>,
         problem: String,
     },
+    /// A model's own error, for its default scene (which adds nothing to say).
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
     #[error("{scene}: object {object}: {source}")]
     Model {
         scene: PathBuf,
@@ -171,12 +176,30 @@ pub struct SceneObject {
     pub texture: Option<Texture>,
 }
 
+/// How a view's turn and zoom ([`render::SceneView`]) move a scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Rig {
+    /// The camera orbits its target (yaw about y, then pitch about x) and zoom divides
+    /// its distance: a scene file's lights stay put in its world.
+    Orbit,
+    /// The objects turn about the origin (yaw about y, then pitch about x) under the
+    /// camera and the lights, as on a turntable: a model's lit side stays towards the
+    /// light as it turns.
+    Turntable {
+        /// Zoom re-frames a sphere of this radius about the origin
+        /// ([`Camera::framing`]: the distance and the near and far planes follow it);
+        /// `None` keeps the scene's camera at every zoom (the benchmark's fixed view).
+        framing: Option<f32>,
+    },
+}
+
 /// A loaded scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
     /// Where it came from (for messages and the status line).
     pub source: String,
     pub camera: Camera,
+    pub rig: Rig,
     pub background: Vec3,
     pub lights: Vec<LightDesc>,
     pub objects: Vec<SceneObject>,
@@ -214,16 +237,102 @@ pub fn is_scene_path(spec: &str) -> bool {
 
 impl Scene {
     /// The default scene of a model (what an OBJ path is shorthand for): the model
-    /// with depth test and per-pixel Lambert under the standard lights, as the viewer
-    /// and the benchmark show it.
+    /// with depth test and per-pixel Lambert under the standard lights, its bounding
+    /// sphere framed, turning on a turntable, as the viewer and `render` show it.
     pub fn for_model(spec: &str) -> Result<Self, SceneError> {
         let text = format!(
             "[[object]]\nmodel = {}\n[object.material]\nlighting = \"lambert\"\n[object.effects]\ndepth_test = true\n",
             toml::Value::String(spec.to_string())
         );
-        let mut scene = Self::from_text(&text, Path::new("default scene"))?;
+        let mut scene =
+            Self::from_text(&text, Path::new("default scene")).map_err(|e| match e {
+                SceneError::Model { source, .. } => SceneError::Mesh(source),
+                e => e,
+            })?;
         scene.source = format!("{spec} (default scene)");
+        let radius = scene.objects[0].mesh.bounding_radius();
+        scene.rig = Rig::Turntable {
+            framing: Some(radius),
+        };
         Ok(scene)
+    }
+
+    /// The benchmark's scene: a model's default scene seen from the standard camera
+    /// ([`Camera::default`]) whatever the model's size, so that figures of one model
+    /// stay comparable from run to run.
+    pub fn standard(spec: &str) -> Result<Self, SceneError> {
+        let mut scene = Self::for_model(spec)?;
+        scene.camera = Camera::default();
+        scene.rig = Rig::Turntable { framing: None };
+        Ok(scene)
+    }
+
+    /// Whether this is a model's default scene rather than a scene file's.
+    #[must_use]
+    pub fn is_model(&self) -> bool {
+        matches!(self.rig, Rig::Turntable { .. })
+    }
+
+    /// How every object is drawn, if they agree: filled, as edges, or both.
+    #[must_use]
+    pub fn mode(&self) -> Option<Mode> {
+        let mode = |e: &EffectsFile| match (e.fill, e.wireframe) {
+            (true, false) => Some(Mode::Fill),
+            (false, true) => Some(Mode::Wire),
+            (true, true) => Some(Mode::FillWire),
+            (false, false) => None,
+        };
+        let first = mode(&self.objects.first()?.desc.effects)?;
+        self.objects
+            .iter()
+            .all(|o| mode(&o.desc.effects) == Some(first))
+            .then_some(first)
+    }
+
+    /// Draws every object in `mode` (the viewer's `w`, `--mode`): its triangles, its
+    /// edges (hidden lines removed where it tests depth), or both; and plans again.
+    pub fn set_mode(&mut self, mode: Mode) {
+        for o in &mut self.objects {
+            o.desc.effects.fill = mode.fills();
+            o.desc.effects.wireframe = mode.wires();
+        }
+        self.replan();
+    }
+
+    /// Whether every object culls back faces (`Some(false)`: none does).
+    #[must_use]
+    pub fn cull(&self) -> Option<bool> {
+        let first = self.objects.first()?.desc.effects.cull;
+        self.objects
+            .iter()
+            .all(|o| o.desc.effects.cull == first)
+            .then_some(first)
+    }
+
+    /// Culls back faces of every object or of none (the viewer's `b`, `--cull`), and
+    /// plans again.
+    pub fn set_cull(&mut self, cull: bool) {
+        for o in &mut self.objects {
+            o.desc.effects.cull = cull;
+        }
+        self.replan();
+    }
+
+    /// The plan again after an effect changed, and the edges of objects that now draw
+    /// them. Only effects drawn outside the shader may change (fill, wireframe,
+    /// culling), so the pipelines chosen by the old plan still fit
+    /// ([`render::is_standard_lambert`] ignores them) and nothing loaded is missing
+    /// but edges.
+    fn replan(&mut self) {
+        let descs: Vec<ObjectDesc> = self.objects.iter().map(|o| o.desc.clone()).collect();
+        self.plan = Plan::new(&descs, &self.lights, self.plan.samples);
+        for (o, op) in self.objects.iter_mut().zip(&self.plan.objects) {
+            if op.edges && o.edges.is_empty() {
+                // From the mesh as drawn: identified by position, its edges are the
+                // loaded mesh's (the per-face split moves no vertex).
+                o.edges = Topology::of(&o.mesh).drawn_edges(&o.mesh.indices);
+            }
+        }
     }
 
     /// Reads and loads a scene file.
@@ -299,6 +408,7 @@ impl Scene {
         Ok(Self {
             source: path.display().to_string(),
             camera,
+            rig: Rig::Orbit,
             background: Vec3::from(f.render.background),
             lights,
             objects,
@@ -403,7 +513,6 @@ fn load_object(
     // Edge topology comes from the mesh as loaded, with vertices identified by
     // position (so texture seams and the per-face split below are not edges).
     let topology = op.edges.then(|| Topology::of(&mesh));
-    let original_indices = op.edges.then(|| mesh.indices.clone());
     let mut face_centres = Vec::new();
     if op.unweld {
         // Flat lighting: every face gets its own three vertices with the face normal.
@@ -438,31 +547,12 @@ fn load_object(
     } else {
         mesh.normals = Vec::new();
     }
-    let (edges, edge_faces) = match (topology, original_indices) {
-        (Some(t), Some(original)) => {
-            // Each edge as two vertices of the mesh that is drawn: the corners of its
-            // first face (the per-face split keeps faces in order).
-            let corner = |face: u32, v: u32| -> u32 {
-                let f = face as usize * 3;
-                let k = t.indices[f..f + 3]
-                    .iter()
-                    .position(|&c| c == v)
-                    .unwrap_or(0);
-                if op.unweld {
-                    (f + k) as u32
-                } else {
-                    original[f + k]
-                }
-            };
-            let edges = t
-                .edges
-                .iter()
-                .zip(&t.faces)
-                .map(|(&[a, b], f)| [corner(f[0], a), corner(f[0], b)])
-                .collect();
+    let (edges, edge_faces) = match topology {
+        Some(t) => {
+            let edges = t.drawn_edges(&mesh.indices);
             (edges, if op.silhouette { t.faces } else { Vec::new() })
         }
-        _ => (Vec::new(), Vec::new()),
+        None => (Vec::new(), Vec::new()),
     };
     Ok(SceneObject {
         desc,
@@ -472,58 +562,4 @@ fn load_object(
         face_centres,
         texture,
     })
-}
-
-/// Edges of a mesh with vertices identified by position.
-struct Topology {
-    /// The triangles' corners as position ids.
-    indices: Vec<u32>,
-    /// Unique edges over position ids.
-    edges: Vec<[u32; 2]>,
-    /// The faces of each edge.
-    faces: Vec<[u32; 2]>,
-}
-
-impl Topology {
-    fn of(mesh: &Mesh) -> Self {
-        let mut ids = std::collections::HashMap::new();
-        let id: Vec<u32> = mesh
-            .positions
-            .iter()
-            .enumerate()
-            .map(|(i, p)| {
-                *ids.entry(p.to_array().map(f32::to_bits))
-                    .or_insert(i as u32)
-            })
-            .collect();
-        let indices: Vec<u32> = mesh.indices.iter().map(|&i| id[i as usize]).collect();
-        let edges = unique_edges(&indices);
-        let faces = edge_faces(&indices, &edges);
-        Self {
-            indices,
-            edges,
-            faces,
-        }
-    }
-}
-
-/// For each unique edge, the triangles that share it (the second is `u32::MAX` on a
-/// boundary; edges shared by more than two keep the first two).
-fn edge_faces(indices: &[u32], edges: &[[u32; 2]]) -> Vec<[u32; 2]> {
-    let mut faces = vec![[u32::MAX; 2]; edges.len()];
-    for (t, tri) in indices.chunks_exact(3).enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            let key = [a.min(b), a.max(b)];
-            if let Ok(e) = edges.binary_search(&key) {
-                let f = &mut faces[e];
-                if f[0] == u32::MAX {
-                    f[0] = t as u32;
-                } else if f[1] == u32::MAX {
-                    f[1] = t as u32;
-                }
-            }
-        }
-    }
-    faces
 }

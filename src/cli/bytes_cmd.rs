@@ -74,7 +74,7 @@ pub fn run(args: &BytesArgs, out: &mut impl Write) -> Result<(), super::CliError
         "model", "glyphs", "colours", "cache B", "exact B", "cache SSIM", "exact SSIM", "ΔSSIM"
     )?;
     for name in &args.models {
-        let model = crate::cli::view_cmd::load_model(name)?;
+        let model = crate::scene::Scene::for_model(name)?;
         for &g in &glyphs {
             for &c in &colors {
                 let r = spin::measure(&config, name, &model, g, c)?;

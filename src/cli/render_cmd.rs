@@ -1,5 +1,5 @@
-//! `termrast render` (one frame to PNG) and `termrast bench render` (the standard
-//! benchmark scene).
+//! `termrast render` (text frames, or one frame to PNG) and `termrast bench render`
+//! (the standard benchmark scene): a model is drawn as its default scene.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -7,15 +7,18 @@ use std::time::Instant;
 
 use clap::Args;
 
-use crate::mesh::Mesh;
 use crate::raster::interp::Interpolation;
 use crate::raster::{Target, Traversal};
 use crate::render::shaders::Lambert;
-use crate::render::standard::{Model, RADIANS_PER_FRAME, StandardFrame, StandardView};
 use crate::render::wire::Mode;
-use crate::render::{Cull, DrawOptions, Isa, Rgba8};
+use crate::render::{Isa, Rgba8};
 use crate::scene::render::{SceneFrame, SceneView};
 use crate::scene::{Scene, is_scene_path};
+use crate::tui::viewport::{SceneState, Viewport};
+
+/// Rotation of a model per frame (of the benchmark and of text frames), radians
+/// about y.
+pub const RADIANS_PER_FRAME: f32 = 0.05;
 
 /// Options shared by the 3D commands.
 #[derive(Debug, Args)]
@@ -24,7 +27,7 @@ pub struct SceneArgs {
     /// OBJ path, or (for `render`) a scene file `SCENE.toml`.
     #[arg(default_value = "teapot")]
     pub model: String,
-    /// Skip back faces.
+    /// Skip back faces (a model; a scene file's effects say).
     #[arg(long)]
     pub cull: bool,
     /// Attribute interpolation.
@@ -33,25 +36,26 @@ pub struct SceneArgs {
     /// Traversal (all give identical images).
     #[arg(long, value_enum, default_value_t = Traversal::Wide)]
     pub traversal: Traversal,
-    /// Filled triangles, wireframe, or filled with visible edges.
+    /// Filled triangles, wireframe, or filled with visible edges (a model; a scene
+    /// file's effects say).
     #[arg(long, value_enum, default_value_t = Mode::Fill)]
     pub mode: Mode,
 }
 
 impl SceneArgs {
-    fn options(&self) -> DrawOptions {
-        DrawOptions {
-            cull: if self.cull { Cull::Back } else { Cull::None },
-            interpolation: self.interpolation,
-            traversal: self.traversal,
-            ..DrawOptions::default()
-        }
+    /// The scene these arguments name: a scene file, or the model's default scene
+    /// drawn in `--mode`, culled with `--cull`.
+    fn scene(&self) -> Result<Scene, crate::scene::SceneError> {
+        super::view_cmd::load(&self.model, self.mode, self.cull)
     }
 
-    fn model(&self) -> Result<Model, crate::mesh::MeshError> {
-        let mut m = Mesh::from_spec(&self.model)?;
-        m.ensure_normals();
-        Ok(Model::new(m))
+    /// The buffers and pipelines for `scene`, with `--interpolation` and
+    /// `--traversal`.
+    fn frame(&self, scene: &Scene) -> SceneFrame {
+        let mut frame = SceneFrame::new(scene);
+        frame.interpolation = self.interpolation;
+        frame.traversal = self.traversal;
+        frame
     }
 }
 
@@ -140,95 +144,73 @@ fn check_png_path(path: &Path) -> Result<(), super::CliError> {
     )))
 }
 
-/// Writes frames of the standard scene as ANSI text, or one as a PNG with `--out`.
+/// Writes frames of a scene (a model's default scene) as ANSI text, or one as a PNG
+/// with `--out`.
 pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
     if let Some(out) = &args.out {
         check_png_path(out)?;
     }
+    let scene = args.scene.scene()?;
     if args.plan {
-        let scene = if is_scene_path(&args.scene.model) {
-            Scene::load(Path::new(&args.scene.model))?
-        } else {
-            Scene::for_model(&args.scene.model)?
-        };
         let mut out = std::io::stdout().lock();
         writeln!(out, "plan of {}", scene.source)?;
         write!(out, "{}", scene.plan)?;
         return Ok(());
     }
-    if is_scene_path(&args.scene.model) {
-        return scene_frames(args);
-    }
-    let model = args.scene.model()?;
-    let Some(out_path) = &args.out else {
-        let mut settings = args.look.settings(args.scene.mode, args.scene.cull);
-        settings.angle = args.angle;
-        settings.tilt = 0.0;
-        return text_frames(args, |vp, n| {
-            settings.angle = args.angle + n as f32 * RADIANS_PER_FRAME;
-            vp.render(&model, &settings, args.cols, args.rows);
-        });
+    let mut frame = args.scene.frame(&scene);
+    // A model turns by `--angle` and then a step per frame; a scene file's clock runs.
+    let model = scene.is_model();
+    let angle = |n: u32| {
+        if model {
+            args.angle + n as f32 * RADIANS_PER_FRAME
+        } else {
+            0.0
+        }
     };
-    let target = args.size;
-    let mut frame = StandardFrame::new(target);
-    let mut color = Rgba8::default();
-    frame.draw(
-        &model,
-        &StandardView::framed(&model, 1.0, args.angle),
-        target,
-        &args.scene.options(),
-        args.scene.mode,
-        &mut color,
-    );
-    // Opaque PNG: the uncovered background (alpha 0 in the target) is black.
-    let bytes: Vec<u8> = color
-        .0
-        .iter()
-        .flat_map(|p| [p[0], p[1], p[2], 255])
-        .collect();
-    image::save_buffer(
-        out_path,
-        &bytes,
-        target.width,
-        target.height,
-        image::ExtendedColorType::Rgba8,
-    )
-    .map_err(|e| super::CliError::Image(out_path.clone(), e))?;
-    Ok(())
+    let time = |n: u32| {
+        if model {
+            0.0
+        } else {
+            n as f32 * SCENE_SECONDS_PER_FRAME
+        }
+    };
+    if let Some(out_path) = &args.out {
+        let target = args.size;
+        let view = SceneView {
+            yaw: angle(0),
+            ..SceneView::default()
+        };
+        frame.draw(&scene, target, &view);
+        return write_png(out_path, &frame.color, target);
+    }
+    let mut settings = args.look.settings();
+    settings.tilt = 0.0;
+    let mut state = SceneState {
+        scene,
+        frame,
+        time: 0.0,
+    };
+    text_frames(args, |vp, n| {
+        settings.angle = angle(n);
+        state.time = time(n);
+        vp.render(&mut state, &settings, (args.cols, args.rows));
+    })
 }
 
 /// Seconds of scene time between text frames.
 pub const SCENE_SECONDS_PER_FRAME: f32 = 0.1;
-
-/// `termrast render SCENE.toml`: text frames, or one PNG with `--out`.
-fn scene_frames(args: &PngArgs) -> Result<(), super::CliError> {
-    let scene = Scene::load(Path::new(&args.scene.model))?;
-    let mut frame = SceneFrame::new(&scene);
-    if let Some(out_path) = &args.out {
-        let target = args.size;
-        frame.draw(&scene, target, &SceneView::default());
-        return write_png(out_path, &frame.color, target);
-    }
-    let mut settings = args.look.settings(Mode::Fill, false);
-    settings.angle = 0.0;
-    settings.tilt = 0.0;
-    text_frames(args, |vp, n| {
-        let t = n as f32 * SCENE_SECONDS_PER_FRAME;
-        vp.render_scene(&scene, &mut frame, &settings, (args.cols, args.rows), t);
-    })
-}
 
 /// Writes `args.frames` frames as ANSI text to stdout; `render(vp, n)` draws frame
 /// `n` into the viewport. Frames are separated by a blank line, or start with
 /// cursor-home with `--animate`.
 fn text_frames(
     args: &PngArgs,
-    mut render: impl FnMut(&mut crate::tui::viewport::Viewport, u32),
+    mut render: impl FnMut(&mut Viewport, u32),
 ) -> Result<(), super::CliError> {
     if let Some(n) = args.look.notice_in(|k| std::env::var(k).ok()) {
         eprintln!("termrast: {n}");
     }
-    let mut vp = crate::tui::viewport::Viewport::default();
+    let mut vp = Viewport::default();
     let mut out = std::io::stdout().lock();
     for n in 0..args.frames {
         render(&mut vp, n);
@@ -295,7 +277,8 @@ impl std::fmt::Display for BenchReport {
     }
 }
 
-/// Runs the standard benchmark: clear colour and depth, draw, per frame.
+/// Runs the standard benchmark: the model's default scene seen from the fixed
+/// camera ([`Scene::standard`]), turning; colour and depth cleared and drawn per frame.
 pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliError> {
     if is_scene_path(&args.scene.model) {
         return Err(super::CliError::Usage(format!(
@@ -304,35 +287,33 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
             args.scene.model
         )));
     }
-    let model = args.scene.model()?;
+    let mut scene = Scene::standard(&args.scene.model)?;
+    scene.set_mode(args.scene.mode);
+    scene.set_cull(args.scene.cull);
     let target = args.size;
-    let opts = args.scene.options();
-    let mut frame = StandardFrame::new(target);
+    let mut frame = args.scene.frame(&scene);
     if let Some(isa) = args.isa {
         frame.renderer.isa = isa;
     }
-    let mut color = Rgba8::default();
     let frames = args.frames.max(1);
     let mut times = Vec::with_capacity(frames as usize);
     let mut covered = 0u64;
     for n in 0..frames {
+        let view = SceneView {
+            yaw: n as f32 * RADIANS_PER_FRAME,
+            ..SceneView::default()
+        };
         let start = Instant::now();
-        frame.draw(
-            &model,
-            &StandardView::at(n as f32 * RADIANS_PER_FRAME),
-            target,
-            &opts,
-            args.scene.mode,
-            &mut color,
-        );
+        frame.draw(&scene, target, &view);
         times.push(start.elapsed().as_secs_f64() * 1e3);
-        covered += frame.renderer.stats.fragments;
+        covered += frame.stats.fragments;
     }
     times.sort_by(f64::total_cmp);
+    let opts = frame.draw_options(&scene.plan.objects[0]);
     Ok(BenchReport {
         median_ms: times[times.len() / 2],
         min_ms: times[0],
-        triangles: model.mesh.triangle_count(),
+        triangles: scene.objects[0].mesh.triangle_count(),
         covered_px: covered / u64::from(frames),
         isa: frame.renderer.copy_for::<Lambert<'_>>(&opts).isa,
     })

@@ -4,9 +4,8 @@ use std::io::{self, Write};
 
 use clap::Args;
 
-use crate::mesh::Mesh;
-use crate::render::standard::Model;
 use crate::render::wire::Mode;
+use crate::scene::{Scene, SceneError, is_scene_path};
 use crate::terminal::glyphs::FitSpace;
 use crate::terminal::{ColorMode, GlyphMode, locale};
 use crate::tui::app::App;
@@ -55,18 +54,13 @@ fn parse_aspect(s: &str) -> Result<f32, String> {
 impl LookArgs {
     /// The view settings these arguments ask for in this environment.
     #[must_use]
-    pub fn settings(&self, mode: Mode, cull: bool) -> ViewSettings {
-        self.settings_in(mode, cull, |k| std::env::var(k).ok())
+    pub fn settings(&self) -> ViewSettings {
+        self.settings_in(|k| std::env::var(k).ok())
     }
 
     /// The view settings in an environment whose variables `get` returns.
     #[must_use]
-    pub fn settings_in(
-        &self,
-        mode: Mode,
-        cull: bool,
-        get: impl Fn(&str) -> Option<String>,
-    ) -> ViewSettings {
+    pub fn settings_in(&self, get: impl Fn(&str) -> Option<String>) -> ViewSettings {
         let colors = self.color.unwrap_or_else(|| ColorMode::detect(&get));
         let utf8 = locale::is_utf8(locale::locale(&get).as_deref());
         let glyphs = match self.glyphs {
@@ -77,10 +71,8 @@ impl LookArgs {
         ViewSettings {
             glyphs,
             colors,
-            mode,
             cell_aspect: self.cell_aspect,
             fit_space: self.fit_space,
-            cull,
             ..ViewSettings::default()
         }
     }
@@ -108,10 +100,11 @@ pub struct ViewArgs {
     pub model: String,
     #[command(flatten)]
     pub look: LookArgs,
-    /// Filled, wireframe, or filled with visible edges.
+    /// Filled, wireframe, or filled with visible edges (a model; a scene file's
+    /// effects say, and `w` changes it).
     #[arg(long, value_enum, default_value_t = Mode::Fill)]
     pub mode: Mode,
-    /// Skip back faces.
+    /// Skip back faces (a model; a scene file's effects say, and `b` changes it).
     #[arg(long)]
     pub cull: bool,
     /// Frame rate cap.
@@ -126,11 +119,16 @@ pub struct ViewArgs {
     pub no_pacing: bool,
 }
 
-/// Loads a model with normals and edges.
-pub fn load_model(spec: &str) -> Result<Model, crate::mesh::MeshError> {
-    let mut m = Mesh::from_spec(spec)?;
-    m.ensure_normals();
-    Ok(Model::new(m))
+/// A scene file (`SCENE.toml`), or a model's default scene drawn in `mode`, culled
+/// with `cull` (a scene file's effects say how it is drawn).
+pub fn load(spec: &str, mode: Mode, cull: bool) -> Result<Scene, SceneError> {
+    if is_scene_path(spec) {
+        return Scene::load(std::path::Path::new(spec));
+    }
+    let mut scene = Scene::for_model(spec)?;
+    scene.set_mode(mode);
+    scene.set_cull(cull);
+    Ok(scene)
 }
 
 /// Runs the viewer.
@@ -139,13 +137,8 @@ pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
     if let Some(why) = locale::no_full_screen(env("TERM").as_deref()) {
         return Err(crate::tui::ViewError::Unsupported(why).into());
     }
-    let settings = args.look.settings(args.mode, args.cull);
-    let mut app = if crate::scene::is_scene_path(&args.model) {
-        let scene = crate::scene::Scene::load(std::path::Path::new(&args.model))?;
-        App::with_scene(scene, settings)
-    } else {
-        App::new(load_model(&args.model)?, settings)
-    };
+    let scene = load(&args.model, args.mode, args.cull)?;
+    let mut app = App::new(scene, args.look.settings());
     app.notice = args.look.notice_in(env);
     crate::tui::run(
         app,
@@ -205,7 +198,7 @@ mod tests {
         ] {
             // Without --glyphs: ascii, and the status line says why, once.
             let plain = look(&[]);
-            let s = plain.settings_in(Mode::Fill, false, env(vars));
+            let s = plain.settings_in(env(vars));
             assert_eq!(s.glyphs, GlyphMode::Ascii, "{vars:?}");
             let notice = plain.notice_in(env(vars)).expect("a notice");
             assert!(
@@ -214,7 +207,7 @@ mod tests {
             );
             // With --glyphs blocks: blocks, and nothing to tell.
             let given = look(&["--glyphs", "blocks"]);
-            let s = given.settings_in(Mode::Fill, false, env(vars));
+            let s = given.settings_in(env(vars));
             assert_eq!(s.glyphs, GlyphMode::Blocks, "{vars:?}");
             assert_eq!(given.notice_in(env(vars)), None, "{vars:?}");
         }
@@ -222,7 +215,7 @@ mod tests {
         let utf8 = [("LANG", "en_US.UTF-8"), ("TERM", "xterm-256color")];
         let plain = look(&[]);
         assert_eq!(
-            plain.settings_in(Mode::Fill, false, env(&utf8)).glyphs,
+            plain.settings_in(env(&utf8)).glyphs,
             GlyphMode::default_for(false)
         );
         assert_eq!(plain.notice_in(env(&utf8)), None);

@@ -13,12 +13,13 @@ use super::config::{Config, View, file_name};
 use super::metrics::{self, Score};
 use super::reference::{self, ReferenceImages};
 use super::{FidelityError, save_png};
-use crate::render::standard::{Model, StandardView};
+use crate::scene::Scene;
+use crate::scene::render::SceneView;
 use crate::terminal::Palette;
 use crate::terminal::glyphs::FitSpace;
 use crate::terminal::paint;
 use crate::terminal::{ColorMode, GlyphMode};
-use crate::tui::viewport::{ViewSettings, Viewport};
+use crate::tui::viewport::{SceneState, ViewSettings, Viewport};
 
 /// Who drew the cells.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -102,7 +103,7 @@ pub fn run(config: &Config) -> Result<Outcome, FidelityError> {
     let mut models = HashMap::new();
     for v in &config.views {
         if !models.contains_key(&v.model) {
-            models.insert(v.model.clone(), crate::cli::view_cmd::load_model(&v.model)?);
+            models.insert(v.model.clone(), Scene::for_model(&v.model)?);
         }
     }
     if let Some(dir) = &config.keep {
@@ -225,7 +226,7 @@ fn size_notes(config: &Config, ms: &[Measurement]) -> Vec<String> {
 
 /// The reference of one camera, rendered and prepared for scoring.
 struct Prepared {
-    camera: StandardView,
+    camera: SceneView,
     images: ReferenceImages,
     metric: metrics::Reference,
 }
@@ -291,13 +292,14 @@ fn variants() -> impl Iterator<Item = (GlyphMode, FitSpace)> {
 /// Every termrast mode and colour depth of one view, then chafa's.
 fn measure_view(
     config: &Config,
-    model: &Model,
+    model: &Scene,
     view: &View,
     chafa: Option<&Chafa>,
 ) -> Result<Outcome, FidelityError> {
     let (cols, rows) = (config.cols, config.rows);
     let (w, h) = config.pixels();
     let mut vp = Viewport::default();
+    let mut state = SceneState::new(model.clone());
     let mut prepared: Option<Prepared> = None;
     let mut out = Outcome::default();
     for (glyphs, fit_space) in variants() {
@@ -319,8 +321,8 @@ fn measure_view(
                 palette: palette.reported(),
                 ..ViewSettings::default()
             };
-            vp.render(model, &settings, cols, rows);
-            let camera = StandardView {
+            vp.render(&mut state, &settings, (cols, rows));
+            let camera = SceneView {
                 pixel_aspect: 1.0,
                 ..vp.view
             };
@@ -335,7 +337,7 @@ fn measure_view(
                             glyphs.name()
                         ));
                     }
-                    let images = reference::render(model, &camera, &settings, w, h);
+                    let images = reference::render(model, &camera, w, h);
                     if let Some(dir) = &config.keep {
                         let name = format!("{}-reference", view.name());
                         save_png(&dir.join(file_name(&name)), &images.image)?;

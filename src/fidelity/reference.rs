@@ -4,11 +4,9 @@
 use image::RgbImage;
 
 use crate::raster::Target;
-use crate::render::Rgba8;
-use crate::render::standard::{Model, StandardFrame, StandardView};
-use crate::render::wire::Mode;
+use crate::scene::Scene;
+use crate::scene::render::{SceneFrame, SceneView};
 use crate::terminal::color::{to_linear, to_srgb};
-use crate::tui::viewport::ViewSettings;
 
 /// Samples per reference pixel along each axis: the view is rendered at this multiple
 /// of the painted screen's size and box-filtered down.
@@ -24,35 +22,26 @@ pub struct ReferenceImages {
     pub image: RgbImage,
 }
 
-/// Renders the standard Lambert scene of `model` with the viewport's camera (`view`,
-/// square pixels) at `SUPERSAMPLE·width × SUPERSAMPLE·height` and box-filters it to
-/// `width × height`. The viewer's draw options are used; uncovered pixels are black.
+/// Renders `scene` as the viewport saw it (`view`, with square pixels) at
+/// `SUPERSAMPLE·width × SUPERSAMPLE·height` and box-filters it to `width × height`.
+/// Uncovered pixels are the scene's background (black for a model).
 #[must_use]
-pub fn render(
-    model: &Model,
-    view: &StandardView,
-    settings: &ViewSettings,
-    width: u32,
-    height: u32,
-) -> ReferenceImages {
+pub fn render(scene: &Scene, view: &SceneView, width: u32, height: u32) -> ReferenceImages {
     let target = Target::new(width * SUPERSAMPLE, height * SUPERSAMPLE);
-    let mut frame = StandardFrame::new(target);
-    let mut color = Rgba8::default();
-    let view = StandardView {
+    let mut frame = SceneFrame::new(scene);
+    let view = SceneView {
         pixel_aspect: 1.0,
         ..*view
     };
-    frame.draw(
-        model,
-        &view,
-        target,
-        &settings.options(),
-        Mode::Fill,
-        &mut color,
-    );
-    // The frame is cleared to black (`standard::BACKGROUND`), so uncovered pixels
-    // (alpha 0) already hold it.
-    let raw: Vec<u8> = color.0.iter().flat_map(|p| [p[0], p[1], p[2]]).collect();
+    frame.draw(scene, target, &view);
+    // The frame is cleared to the background, so uncovered pixels (alpha 0) already
+    // hold it.
+    let raw: Vec<u8> = frame
+        .color
+        .0
+        .iter()
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
     let full = RgbImage::from_raw(target.width, target.height, raw)
         .unwrap_or_else(|| RgbImage::new(target.width, target.height));
     let image = box_filter(&full, SUPERSAMPLE);

@@ -14,10 +14,11 @@ use ratatui::layout::Rect;
 use super::FidelityError;
 use super::metrics;
 use super::reference;
-use crate::render::standard::{Model, StandardView};
+use crate::scene::Scene;
+use crate::scene::render::SceneView;
 use crate::terminal::{ColorMode, GlyphMode, paint};
 use crate::tui::link::{DELTA_E, LinkBackend};
-use crate::tui::viewport::{ViewSettings, Viewport};
+use crate::tui::viewport::{SceneState, ViewSettings, Viewport};
 
 /// What to measure.
 #[derive(Clone, Debug)]
@@ -96,7 +97,7 @@ impl Stream {
 pub fn measure(
     config: &SpinConfig,
     name: &str,
-    model: &Model,
+    model: &Scene,
     glyphs: GlyphMode,
     colors: ColorMode,
 ) -> Result<SpinRow, FidelityError> {
@@ -110,7 +111,8 @@ pub fn measure(
     let mut prev = Buffer::empty(area);
     let mut bytes = [0usize; 2];
     let mut ssim = [0f64; 2];
-    let mut reference: Option<(StandardView, metrics::Reference)> = None;
+    let mut reference: Option<(SceneView, metrics::Reference)> = None;
+    let mut state = SceneState::new(model.clone());
     let (w, h) = (
         u32::from(cols) * paint::CELL_WIDTH,
         u32::from(rows) * paint::CELL_HEIGHT,
@@ -122,7 +124,7 @@ pub fn measure(
             angle: 0.6 + config.step * k as f32,
             ..ViewSettings::default()
         };
-        vp.render(model, &settings, cols, rows);
+        vp.render(&mut state, &settings, (cols, rows));
         let mut next = Buffer::empty(area);
         ratatui::widgets::Widget::render(&vp, area, &mut next);
         for (s, total) in streams.iter_mut().zip(&mut bytes) {
@@ -133,14 +135,14 @@ pub fn measure(
         }
         prev = next;
         if config.score && k > 0 {
-            let camera = StandardView {
+            let camera = SceneView {
                 pixel_aspect: 1.0,
                 ..vp.view
             };
             let metric = match reference.take() {
                 Some((c, m)) if c == camera => m,
                 _ => {
-                    let images = reference::render(model, &camera, &settings, w, h);
+                    let images = reference::render(model, &camera, w, h);
                     metrics::Reference::new(&images.image)?
                 }
             };

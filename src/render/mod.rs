@@ -49,7 +49,6 @@ pub mod prepare;
 pub mod probe;
 pub mod shader;
 pub mod shaders;
-pub mod standard;
 pub mod target;
 pub mod wire;
 

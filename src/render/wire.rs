@@ -22,6 +22,9 @@ use crate::raster::line::{Line, NoTrace, Step, Tracer};
 /// model's size.
 pub const WIRE_DEPTH_BIAS: f32 = 2e-4;
 
+/// Colour of wireframe lines.
+pub const WIRE_COLOR: Vec3 = Vec3::new(1.0, 0.75, 0.2);
+
 /// How the mesh is shown.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum Mode {

@@ -220,15 +220,32 @@ impl Default for MaterialFile {
 }
 
 /// `[object.effects]`.
-#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq)]
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct EffectsFile {
+    /// Draw the triangles (off: only the edges and silhouettes, as the viewer's
+    /// wireframe mode shows a model).
+    pub fill: bool,
     pub depth_test: bool,
     pub cull: bool,
     pub fog: Option<FogFile>,
     pub depth_shading: bool,
     pub wireframe: bool,
     pub silhouette: bool,
+}
+
+impl Default for EffectsFile {
+    fn default() -> Self {
+        Self {
+            fill: true,
+            depth_test: false,
+            cull: false,
+            fog: None,
+            depth_shading: false,
+            wireframe: false,
+            silhouette: false,
+        }
+    }
 }
 
 /// `fog = { start = .., end = .., color = [..] }`: linear fog by view depth.

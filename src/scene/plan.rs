@@ -100,6 +100,10 @@ pub struct ObjectPlan {
     pub vertex_colors: bool,
     pub uvs: bool,
     pub texture: TextureMode,
+    /// The triangles are drawn (else only edges and silhouettes).
+    pub fill: bool,
+    /// The triangles' depth test (with [`ObjectPlan::fill`]: see
+    /// [`ObjectPlan::writes_depth`]).
     pub depth_test: bool,
     pub cull: bool,
     pub fog: bool,
@@ -111,6 +115,15 @@ pub struct ObjectPlan {
     /// Unique edges are computed (wireframe or silhouettes).
     pub edges: bool,
     pub lines: Vec<StageLine>,
+}
+
+impl ObjectPlan {
+    /// Its triangles are drawn and depth-tested, so it needs the depth buffer and can
+    /// hide lines.
+    #[must_use]
+    pub fn writes_depth(&self) -> bool {
+        self.fill && self.depth_test
+    }
 }
 
 /// The plan of a scene.
@@ -131,7 +144,7 @@ impl Plan {
         let depth_users: Vec<String> = objects
             .iter()
             .enumerate()
-            .filter(|(_, o)| o.depth_test)
+            .filter(|(_, o)| o.writes_depth())
             .map(|(i, _)| (i + 1).to_string())
             .collect();
         let depth_buffer = !depth_users.is_empty();
@@ -196,7 +209,7 @@ fn object_plan(o: &ObjectDesc, lights: &[LightDesc]) -> ObjectPlan {
     };
     let normals = lighting != Lighting::None;
     let world_positions = varyings.position || lighting.per_vertex();
-    let hidden_lines = e.wireframe && e.depth_test;
+    let hidden_lines = e.wireframe && e.depth_test && e.fill;
     let why_lighting_off = if shading {
         "depth shading replaces lighting"
     } else {
@@ -308,6 +321,10 @@ fn object_plan(o: &ObjectDesc, lights: &[LightDesc]) -> ObjectPlan {
     });
     lines.push(match (e.wireframe, hidden_lines) {
         (true, true) => on("wireframe", "hidden lines removed against the depth buffer"),
+        (true, false) if !e.fill => on(
+            "wireframe",
+            "every edge: no triangles are filled to hide lines",
+        ),
         (true, false) => on(
             "wireframe",
             "every edge: hidden-line removal needs depth_test",
@@ -319,6 +336,28 @@ fn object_plan(o: &ObjectDesc, lights: &[LightDesc]) -> ObjectPlan {
     } else {
         off("silhouettes", "silhouette = false")
     });
+    if !e.fill {
+        // No fragments: the stages that run per pixel do nothing. The vertex stage
+        // still runs for the edges.
+        let per_pixel = [
+            "lighting",
+            "texture lookups",
+            "depth test",
+            "fog",
+            "depth shading",
+        ];
+        for l in lines.iter_mut().filter(|l| per_pixel.contains(&l.stage)) {
+            if l.on && (l.stage != "lighting" || lighting.per_pixel()) {
+                *l = off(l.stage, "fill = false: no triangles are filled");
+            }
+        }
+        let at = lines.iter().position(|l| l.stage == "depth test");
+        let line = off(
+            "triangles",
+            "fill = false: only edges and silhouettes are drawn",
+        );
+        lines.insert(at.unwrap_or(lines.len()), line);
+    }
     ObjectPlan {
         name: o.name.clone(),
         varyings,
@@ -328,6 +367,7 @@ fn object_plan(o: &ObjectDesc, lights: &[LightDesc]) -> ObjectPlan {
         vertex_colors,
         uvs: varyings.uv,
         texture,
+        fill: e.fill,
         depth_test: e.depth_test,
         cull: e.cull,
         fog,

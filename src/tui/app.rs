@@ -10,10 +10,8 @@ use ratatui::layout::{Position, Rect};
 use super::inspector::{LineFocus, line_at_sample, project_focus};
 use super::status::{FpsMeter, StatusLine};
 use super::viewport::{SceneState, ViewSettings, Viewport};
-use crate::render::standard::Model;
 use crate::render::wire::Mode;
-use crate::scene::Scene;
-use crate::scene::render::SceneFrame;
+use crate::scene::{Rig, Scene};
 use crate::terminal::{ColorMode, GlyphMode};
 
 /// Smallest usable terminal.
@@ -30,7 +28,8 @@ const SPIN: f32 = 0.8;
 /// The viewer.
 #[derive(Debug)]
 pub struct App {
-    pub model: Model,
+    /// What is shown (a model is its default scene), with its buffers and clock.
+    pub scene: SceneState,
     pub settings: ViewSettings,
     pub viewport: Viewport,
     pub paused: bool,
@@ -63,8 +62,6 @@ pub struct App {
     /// Where the model and the panel are on screen, from the last draw.
     pub(super) view_area: Rect,
     pub(super) panel_area: Rect,
-    /// A scene shown instead of the model, with its buffers and clock.
-    pub scene: Option<SceneState>,
     /// Show the scene's plan.
     pub show_plan: bool,
 }
@@ -85,11 +82,19 @@ pub struct LinkStatus {
 }
 
 impl App {
-    /// A viewer for a model.
+    /// A viewer for a scene. A model's default scene turns on its turntable, seen
+    /// turned and tilted as `settings` say; a scene file runs its clock (its objects
+    /// spin as it says) and is first seen from its own camera, which the arrows and
+    /// the mouse then orbit.
     #[must_use]
-    pub fn new(model: Model, settings: ViewSettings) -> Self {
+    pub fn new(scene: Scene, settings: ViewSettings) -> Self {
+        let mut settings = settings;
+        if scene.rig == Rig::Orbit {
+            settings.angle = 0.0;
+            settings.tilt = 0.0;
+        }
         Self {
-            model,
+            scene: SceneState::new(scene),
             settings,
             viewport: Viewport::default(),
             paused: false,
@@ -111,38 +116,22 @@ impl App {
             drag: None,
             view_area: Rect::default(),
             panel_area: Rect::default(),
-            scene: None,
             show_plan: false,
         }
     }
 
-    /// A viewer for a scene: its objects spin as the file says, and the arrows and
-    /// mouse orbit the camera about its target.
-    #[must_use]
-    pub fn with_scene(scene: Scene, settings: ViewSettings) -> Self {
-        let frame = SceneFrame::new(&scene);
-        let mut app = Self::new(Model::new(crate::mesh::Mesh::default()), settings);
-        app.settings.angle = 0.0;
-        app.settings.tilt = 0.0;
-        app.scene = Some(SceneState {
-            scene,
-            frame,
-            time: 0.0,
-        });
-        app
-    }
-
-    /// Advances the animation by `dt`.
+    /// Advances the animation by `dt`: the turntable turns, a scene file's clock runs.
     pub fn tick(&mut self, dt: Duration) {
         if self.paused {
             return;
         }
-        if let Some(s) = &mut self.scene {
-            s.time += dt.as_secs_f32();
-            return;
+        match self.scene.scene.rig {
+            Rig::Turntable { .. } => {
+                self.settings.angle =
+                    (self.settings.angle + SPIN * dt.as_secs_f32()) % std::f32::consts::TAU;
+            }
+            Rig::Orbit => self.scene.time += dt.as_secs_f32(),
         }
-        self.settings.angle =
-            (self.settings.angle + SPIN * dt.as_secs_f32()) % std::f32::consts::TAU;
     }
 
     /// A frame was drawn at `now` (for the frame rate).
@@ -258,11 +247,10 @@ impl App {
     /// selected sample.
     pub(super) fn focused_line(&self) -> Option<(LineFocus, crate::render::wire::ScreenLine)> {
         match self.line_focus {
-            Some(f) => project_focus(&self.viewport, self.scene.as_ref(), f).map(|sl| (f, sl)),
+            Some(f) => project_focus(&self.scene, f).map(|sl| (f, sl)),
             None => line_at_sample(
                 &self.viewport,
-                &self.model,
-                self.scene.as_ref(),
+                &self.scene,
                 (self.cursor.0, self.cursor.1, self.sub),
             ),
         }
@@ -275,10 +263,10 @@ impl App {
         };
         f.k = (f.k + by).clamp(0, sl.line.dx);
         let (px, py) = sl.line.pixel(f.k, sl.line.minor_at(f.k));
-        // A scene's line is in its supersampled grid.
-        let side = self.scene.as_ref().map_or(1, |s| {
-            i64::from(crate::raster::samples::grid_side(s.scene.plan.samples))
-        });
+        // The line is in the frame's (supersampled) grid.
+        let side = i64::from(crate::raster::samples::grid_side(
+            self.scene.scene.plan.samples,
+        ));
         let (px, py) = (px.div_euclid(side), py.div_euclid(side));
         let (sx, sy) = self.settings.glyphs.dims();
         let (tw, th) = (
@@ -326,13 +314,16 @@ impl App {
                 }
             }
             KeyCode::Char('?') => self.help = !self.help,
-            KeyCode::Char('p') if self.scene.is_some() => self.show_plan = !self.show_plan,
+            KeyCode::Char('p') if !self.scene.scene.is_model() => self.show_plan = !self.show_plan,
             KeyCode::Char('p') => {
                 self.notice = Some("no scene plan: p shows the plan of a scene file".into());
             }
             KeyCode::Char(' ') => self.set_paused(!self.paused),
             KeyCode::Char('i') => self.set_inspect(!self.inspect),
-            KeyCode::Char('w') => self.settings.mode = Self::cycle(&Mode::ALL, self.settings.mode),
+            KeyCode::Char('w') => {
+                let s = &mut self.scene.scene;
+                s.set_mode(Self::cycle(&Mode::ALL, s.mode().unwrap_or(Mode::Fill)));
+            }
             KeyCode::Char('g') => {
                 self.settings.glyphs = Self::cycle(&GlyphMode::ALL, self.settings.glyphs);
                 self.sub = 0;
@@ -341,7 +332,10 @@ impl App {
             KeyCode::Char('c') => {
                 self.settings.colors = Self::cycle(&ColorMode::ALL, self.settings.colors)
             }
-            KeyCode::Char('b') => self.settings.cull = !self.settings.cull,
+            KeyCode::Char('b') => {
+                let s = &mut self.scene.scene;
+                s.set_cull(!s.cull().unwrap_or(false));
+            }
             KeyCode::Char('+') | KeyCode::Char('=') => self.zoom(1.1),
             KeyCode::Char('-') => self.zoom(1.0 / 1.1),
             KeyCode::PageUp => self.scroll_panel(-10),

@@ -12,7 +12,7 @@ use ratatui::text::Line;
 use ratatui::widgets::{Block, Borders, Clear, Paragraph, Wrap};
 
 use super::app::{App, MIN_COLS, MIN_ROWS, PANEL_COLS};
-use super::inspector::{inspector_text, line_text, scene_inspector_text};
+use super::inspector::{inspector_text, line_text};
 use super::panel::{PanelText, window};
 use super::status::Priority;
 use crate::render::wire::Mode;
@@ -90,18 +90,8 @@ impl App {
         } = self.areas(area);
         self.view_area = view;
         self.panel_area = panel;
-        match &mut self.scene {
-            Some(s) => self.viewport.render_scene(
-                &s.scene,
-                &mut s.frame,
-                &self.settings,
-                (view.width, view.height),
-                s.time,
-            ),
-            None => self
-                .viewport
-                .render(&self.model, &self.settings, view.width, view.height),
-        }
+        self.viewport
+            .render(&mut self.scene, &self.settings, (view.width, view.height));
         self.place_cursor_on_model();
         self.cursor = (
             self.cursor.0.min(view.width - 1),
@@ -126,8 +116,7 @@ impl App {
     }
 
     fn draw_plan(&self, f: &mut Frame, area: Rect) {
-        let Some(s) = &self.scene else { return };
-        let text = s.scene.plan.to_string();
+        let text = self.scene.scene.plan.to_string();
         let w = 76.min(area.width);
         let inner = usize::from(w.saturating_sub(2)).max(1);
         // Rows the plan takes once wrapped to the box.
@@ -152,10 +141,7 @@ impl App {
     /// side by side when it is a wide strip below the model.
     fn draw_panel(&mut self, f: &mut Frame, area: Rect) {
         let (cx, cy) = self.cursor;
-        let text = match &self.scene {
-            Some(s) => scene_inspector_text(&self.viewport, s, cx, cy, self.sub),
-            None => inspector_text(&self.viewport, &self.model, cx, cy, self.sub),
-        };
+        let text = inspector_text(&self.viewport, &self.scene, cx, cy, self.sub);
         let line = match self.focused_line() {
             Some((focus, sl)) => line_text(focus, &sl),
             None => {
@@ -173,7 +159,7 @@ impl App {
             let line_rows = line_rows.min(area.height / 2).max(3);
             Layout::vertical([Constraint::Min(3), Constraint::Length(line_rows)]).areas(area)
         };
-        let title = if self.scene.is_some() {
+        let title = if !self.scene.scene.is_model() {
             " inspector (Tab: sample, PgUp/PgDn, p: plan) "
         } else {
             " inspector (Tab: sample, PgUp/PgDn) "
@@ -185,11 +171,10 @@ impl App {
     /// Rewrites the status line: the fields in order, each with its importance (the
     /// line is fitted to the terminal's width when drawn).
     pub fn update_status(&mut self) {
-        let stats = match &self.scene {
-            Some(sc) => sc.frame.stats,
-            None => self.viewport.frame.renderer.stats,
-        };
-        let [tf, rs] = self.viewport.frame.timing;
+        let scene = &self.scene.scene;
+        let frame = &self.scene.frame;
+        let stats = frame.stats;
+        let [tf, rs] = frame.timing;
         let ms = |d: Duration| d.as_secs_f64() * 1e3;
         let s = &mut self.status;
         s.clear();
@@ -210,15 +195,17 @@ impl App {
                 self.settings.colors.name()
             ),
         );
-        let mut drawing = match self.settings.mode {
-            Mode::Fill => "fill".to_string(),
-            Mode::Wire => format!("wire {} lines", self.viewport.wire.lines),
-            Mode::FillWire => format!("fill+wire {} lines", self.viewport.wire.lines),
+        let lines = self.viewport.wire.lines;
+        let mut drawing = match scene.mode() {
+            Some(Mode::Fill) => "fill".to_string(),
+            Some(Mode::Wire) => format!("wire {lines} lines"),
+            Some(Mode::FillWire) => format!("fill+wire {lines} lines"),
+            None => format!("fill/wire by object {lines} lines"),
         };
-        drawing.push_str(if self.settings.cull {
-            " cull"
-        } else {
-            " no cull"
+        drawing.push_str(match scene.cull() {
+            Some(true) => " cull",
+            Some(false) => " no cull",
+            None => " cull by object",
         });
         s.push(Priority::Drawing, drawing);
         if let (false, Some(fps)) = (self.paused, self.fps.fps()) {
@@ -261,10 +248,10 @@ impl App {
         }
         s.push(Priority::Link, link);
         s.push(Priority::Always, "? help");
-        if let Some(sc) = &self.scene {
+        if !scene.is_model() {
             s.push(
                 Priority::Drawing,
-                format!("plan: {} (p)", sc.scene.plan.summary()),
+                format!("plan: {} (p)", scene.plan.summary()),
             );
         }
     }

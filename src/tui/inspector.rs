@@ -2,13 +2,14 @@
 //! the names `docs/rasterization.md` defines (F01, F02, F03, u, v, w, depth, octant, dx, dy, incrE,
 //! incrNE, d).
 
+use glam::Vec3;
+
 use crate::raster::line::Move;
 use crate::raster::samples::grid_side;
-use crate::render::Shader;
-use crate::render::probe::{DepthOutcome, Probe, probe};
-use crate::render::standard::{Model, StandardFrame};
+use crate::render::probe::{DepthOutcome, Probe, ProbeRecord};
 use crate::render::target::luminance;
-use crate::render::wire::{ScreenLine, line_under, project_edge};
+use crate::render::wire::ScreenLine;
+use crate::scene::render::ShadedProbe;
 use crate::terminal::GlyphMode;
 use crate::terminal::glyphs::{Sample, explain};
 
@@ -63,18 +64,35 @@ fn listed(vp: &Viewport, n: usize, sub: usize) -> std::ops::Range<usize> {
     row * sx..(row + 1) * sx
 }
 
-/// The inspector text for cell `(cx, cy)`, detailing sub-sample `sub`.
+/// A probe record with the colour its fragment was shaded.
+type ShadedRecord = ProbeRecord<Option<Vec3>>;
+
+/// What the probe of a scene pixel says, all objects together: the object and the
+/// record in the framebuffer, if any, and how many triangles' boxes hold the pixel.
+fn seen(probes: &[ShadedProbe]) -> (Option<(usize, &ShadedRecord)>, usize) {
+    let touched = probes.iter().map(|p| p.records.len()).sum();
+    let winner = probes
+        .iter()
+        .enumerate()
+        .rev()
+        .find_map(|(i, p)| p.winner.map(|w| (i, &p.records[w])));
+    (winner, touched)
+}
+
+/// The inspector text for cell `(cx, cy)`, detailing sub-sample `sub`: the cell's
+/// glyph and colours and why, each listed sample's triangle, depth and shade, then
+/// for the selected sample every object's overdraw list in draw order (depth carried
+/// from object to object), each object with its pipeline's varyings.
 #[must_use]
-pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize) -> PanelText {
+pub fn inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub: usize) -> PanelText {
     let Some((mut t, _, n)) = cell_header(vp, cx, cy) else {
         let mut t = PanelText::default();
         t.prose(0, "cursor outside the view");
         return t;
     };
-    let opts = vp.settings.options();
-    let indices = &model.mesh.indices;
-    let view = vp.view;
-    let shader = StandardFrame::shader(&model.mesh, &view, vp.target);
+    let scene = &s.scene;
+    // A scene file's objects are named; a model's default scene is the model.
+    let named = !scene.is_model();
     let rows = listed(vp, n, sub);
     if rows.len() < n {
         t.fields(
@@ -87,50 +105,65 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
     } else {
         t.fields(0, [format!("samples ({n} per cell):")]);
     }
-    // The selected sample's probe is kept for the overdraw list below.
+    // The selected sample's probes are kept for the overdraw lists below.
     let mut selected = None;
     for k in rows {
         let (x, y) = sample_pixel(vp, cx, cy, k);
-        let p = probe(&vp.frame.cache, indices, vp.target, &opts, x, y);
+        let (fx, fy) = scene_pixel(vp, s, cx, cy, k);
+        let probes = s.frame.probe(scene, fx, fy);
+        let (winner, touched) = seen(&probes);
         let mark = if k == sub % n { '>' } else { ' ' };
-        let touched = format!("({} touched)", p.records.len());
-        match p.winner.map(|w| &p.records[w]) {
-            Some(r) => {
-                let shade = luminance(shader.fragment(&r.varying));
+        let at = format!("{mark}s{k} ({x},{y})");
+        match winner {
+            Some((i, r)) => {
+                let of = if named {
+                    format!(" of {}", scene.objects[i].desc.name)
+                } else {
+                    String::new()
+                };
+                let shade = r.varying.map_or(0.0, luminance);
                 let shade = format!("shade {shade:.3}");
                 t.fields_or(
                     0,
                     [
-                        format!("{mark}s{k} ({x},{y})"),
-                        format!("covered by t{}", r.triangle),
+                        at.clone(),
+                        format!("covered by t{}{of}", r.triangle),
                         format!("depth {:.5}", r.eval.depth),
                         shade.clone(),
-                        touched,
+                        format!("({touched} touched)"),
                     ],
                     [
-                        format!("{mark}s{k} ({x},{y})"),
-                        format!("t{}", r.triangle),
+                        at,
+                        format!("t{}{of}", r.triangle),
                         format!("z {:.5}", r.eval.depth),
                         shade,
-                        format!("{} touched", p.records.len()),
+                        format!("{touched} touched"),
                     ],
                 );
             }
             None => t.fields(
                 0,
-                [
-                    format!("{mark}s{k} ({x},{y})"),
-                    "not covered".into(),
-                    touched,
-                ],
+                [at, "not covered".into(), format!("({touched} touched)")],
             ),
         }
         if k == sub % n {
-            selected = Some(p);
+            selected = Some(probes);
         }
     }
     let (x, y) = sample_pixel(vp, cx, cy, sub);
-    let Some(p) = selected else { return t };
+    let Some(probes) = selected else { return t };
+    let side = grid_side(scene.plan.samples);
+    if side > 1 {
+        let (fx, fy) = scene_pixel(vp, s, cx, cy, sub);
+        t.fields(
+            0,
+            [
+                "supersampled:".to_string(),
+                format!("probing sample ({fx},{fy})"),
+                format!("of its {side}×{side} grid"),
+            ],
+        );
+    }
     t.fields(
         0,
         [
@@ -138,7 +171,26 @@ pub fn inspector_text(vp: &Viewport, model: &Model, cx: u16, cy: u16, sub: usize
             "overdraw in draw order:".into(),
         ],
     );
-    overdraw_text(&mut t, &p, opts.depth.uses_buffer());
+    for ((p, obj), op) in probes.iter().zip(&scene.objects).zip(&scene.plan.objects) {
+        if named {
+            t.fields(
+                0,
+                [
+                    format!("object {}", obj.desc.name),
+                    format!(
+                        "({})",
+                        if op.writes_depth() {
+                            "depth test"
+                        } else {
+                            "no depth test"
+                        }
+                    ),
+                    format!("varyings {}:", op.varyings),
+                ],
+            );
+        }
+        overdraw_text(&mut t, p, op.writes_depth());
+    }
     t
 }
 
@@ -201,74 +253,6 @@ fn overdraw_text<V>(t: &mut PanelText, p: &Probe<V>, depth_test: bool) {
     }
 }
 
-/// The inspector text for a scene: the cell's glyph and samples, then for the
-/// selected sample each object's overdraw list in draw order (depth carried from
-/// object to object), with the object's pipeline.
-#[must_use]
-pub fn scene_inspector_text(
-    vp: &Viewport,
-    s: &SceneState,
-    cx: u16,
-    cy: u16,
-    sub: usize,
-) -> PanelText {
-    let Some((mut t, samples, n)) = cell_header(vp, cx, cy) else {
-        let mut t = PanelText::default();
-        t.prose(0, "cursor outside the view");
-        return t;
-    };
-    for k in listed(vp, n, sub) {
-        let smp = samples[k];
-        let mark = if k == sub % n { '>' } else { ' ' };
-        let (x, y) = sample_pixel(vp, cx, cy, k);
-        t.fields(
-            0,
-            [
-                format!("{mark}s{k} ({x},{y})"),
-                (if smp.covered { "covered" } else { "empty" }).to_string(),
-                hex(Some(smp.rgb)),
-            ],
-        );
-    }
-    let (fx, fy) = scene_pixel(vp, s, cx, cy, sub);
-    let side = grid_side(s.scene.plan.samples);
-    if side > 1 {
-        t.fields(
-            0,
-            [
-                "supersampled:".to_string(),
-                format!("probing sample ({fx},{fy})"),
-                format!("of its {side}×{side} grid"),
-            ],
-        );
-    }
-    for ((p, obj), op) in s
-        .frame
-        .probe(&s.scene, fx, fy)
-        .iter()
-        .zip(&s.scene.objects)
-        .zip(&s.scene.plan.objects)
-    {
-        t.fields(
-            0,
-            [
-                format!("object {}", obj.desc.name),
-                format!(
-                    "({})",
-                    if op.depth_test {
-                        "depth test"
-                    } else {
-                        "no depth test"
-                    }
-                ),
-                format!("varyings {}:", op.varyings),
-            ],
-        );
-        overdraw_text(&mut t, p, op.depth_test);
-    }
-    t
-}
-
 /// The pixel of the scene's (possibly supersampled) frame that stands for sub-sample
 /// `sub` of cell `(cx, cy)`: the middle of its grid.
 #[must_use]
@@ -278,77 +262,35 @@ pub fn scene_pixel(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub: usize) 
     (x * side + side / 2, y * side + side / 2)
 }
 
-/// The line the line panel shows: a model's edge, or an edge of a scene's object, and
-/// the step along it.
+/// The line the line panel shows: an edge of one of the scene's objects, and the
+/// step along it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LineFocus {
-    /// The scene object, for scenes.
+    /// The object, named for a scene file's (a model's default scene has one).
     pub object: Option<usize>,
     pub edge: [u32; 2],
     pub k: i64,
 }
 
-/// The line under sub-sample `sub` of cell `(cx, cy)` (see [`line_under`]), with its
-/// screen line in the frame's pixel grid (a scene's supersampled one).
+/// The line under sub-sample `sub` of cell `(cx, cy)` (see
+/// [`SceneFrame::line_under`](crate::scene::render::SceneFrame::line_under)), with its
+/// screen line in the frame's (supersampled) pixel grid.
 #[must_use]
 pub fn line_at_sample(
     vp: &Viewport,
-    model: &Model,
-    scene: Option<&SceneState>,
+    s: &SceneState,
     (cx, cy, sub): (u16, u16, usize),
 ) -> Option<(LineFocus, ScreenLine)> {
-    if let Some(s) = scene {
-        let (fx, fy) = scene_pixel(vp, s, cx, cy, sub);
-        let (object, edge, sl, k) = s.frame.line_under(&s.scene, fx, fy)?;
-        return Some((
-            LineFocus {
-                object: Some(object),
-                edge,
-                k,
-            },
-            sl,
-        ));
-    }
-    let (x, y) = sample_pixel(vp, cx, cy, sub);
-    let depth = vp.settings.mode.fills().then_some(&vp.frame.renderer.depth);
-    let wires = vp
-        .settings
-        .mode
-        .wires()
-        .then_some((model.edges.as_slice(), depth));
-    let opts = vp.settings.options();
-    let p = probe(&vp.frame.cache, &model.mesh.indices, vp.target, &opts, x, y);
-    let triangle = p.winner.map(|w| p.records[w].triangle);
-    let (edge, sl, k) = line_under(
-        &vp.frame.cache,
-        &model.mesh.indices,
-        wires,
-        triangle,
-        vp.target,
-        x,
-        y,
-    )?;
-    Some((
-        LineFocus {
-            object: None,
-            edge,
-            k,
-        },
-        sl,
-    ))
+    let (fx, fy) = scene_pixel(vp, s, cx, cy, sub);
+    let (object, edge, sl, k) = s.frame.line_under(&s.scene, fx, fy)?;
+    let object = (!s.scene.is_model()).then_some(object);
+    Some((LineFocus { object, edge, k }, sl))
 }
 
 /// The screen line of a focus, this frame.
 #[must_use]
-pub fn project_focus(
-    vp: &Viewport,
-    scene: Option<&SceneState>,
-    f: LineFocus,
-) -> Option<ScreenLine> {
-    match (scene, f.object) {
-        (Some(s), Some(o)) => s.frame.project_edge(o, f.edge),
-        _ => project_edge(&vp.frame.cache, f.edge, vp.target),
-    }
+pub fn project_focus(s: &SceneState, f: LineFocus) -> Option<ScreenLine> {
+    s.frame.project_edge(f.object.unwrap_or(0), f.edge)
 }
 
 /// The line panel for a line and a step on it.

@@ -1,5 +1,5 @@
-//! The viewport: the model rendered at sub-sample resolution into the cells it is
-//! given, as a ratatui widget.
+//! The viewport: a scene (a model is a one-object scene) rendered at sub-sample
+//! resolution into the cells it is given, as a ratatui widget.
 
 use std::time::{Duration, Instant};
 
@@ -9,28 +9,28 @@ use ratatui::style::{Color, Style};
 use ratatui::widgets::Widget;
 
 use crate::raster::Target;
-use crate::render::standard::{Model, StandardFrame, StandardView};
-use crate::render::wire::{Mode, WireCount};
-use crate::render::{Cull, DrawOptions, Rgba8};
+use crate::render::Rgba8;
+use crate::render::wire::WireCount;
 use crate::scene::Scene;
 use crate::scene::render::{SceneFrame, SceneView};
 use crate::terminal::fit;
 use crate::terminal::glyphs::{FitSpace, Sample, fit_cell_in, fit_cells8};
 use crate::terminal::{CellGlyph, ColorMode, GlyphMode, Palette};
 
-/// What the viewer shows and how.
+/// What the viewer shows and how; how the scene is drawn (filled or as edges,
+/// culled) is the scene's own ([`Scene::set_mode`], [`Scene::set_cull`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewSettings {
     pub glyphs: GlyphMode,
     pub colors: ColorMode,
-    pub mode: Mode,
     /// Cell width over cell height.
     pub cell_aspect: f32,
-    /// Camera zoom (1 = the standard distance 2.6).
+    /// Camera zoom (1 = the scene's framing or camera).
     pub zoom: f32,
+    /// Radians about y, then about x: the model's turn, or the camera's orbit about
+    /// a scene file's target (see [`crate::scene::Rig`]).
     pub angle: f32,
     pub tilt: f32,
-    pub cull: bool,
     /// Where the shape-fitted modes measure colour error.
     pub fit_space: FitSpace,
     /// The terminal's 16 colours (xterm's unless it said otherwise).
@@ -42,12 +42,10 @@ impl Default for ViewSettings {
         Self {
             glyphs: GlyphMode::Braille,
             colors: ColorMode::Truecolor,
-            mode: Mode::Fill,
             cell_aspect: 0.5,
             zoom: 1.0,
             angle: 0.6,
             tilt: 0.25,
-            cull: false,
             fit_space: FitSpace::Srgb,
             palette: Palette::XTERM,
         }
@@ -55,15 +53,18 @@ impl Default for ViewSettings {
 }
 
 impl ViewSettings {
-    /// The camera and model rotation for `model`, for a glyph mode's samples: the
-    /// model's bounding sphere framed at zoom 1, whatever the view's aspect.
+    /// The view of a frame at `time` seconds, for the glyph mode's samples (whose
+    /// pixel aspect follows from the cell's).
     #[must_use]
-    pub fn view(&self, model: &Model) -> StandardView {
+    pub fn view(&self, time: f32) -> SceneView {
         let (sx, sy) = self.glyphs.dims();
-        let mut v = StandardView::framed(model, self.zoom, self.angle);
-        v.tilt = self.tilt;
-        v.pixel_aspect = self.cell_aspect * sy as f32 / sx as f32;
-        v
+        SceneView {
+            time,
+            yaw: self.angle,
+            pitch: self.tilt,
+            zoom: self.zoom,
+            pixel_aspect: self.cell_aspect * sy as f32 / sx as f32,
+        }
     }
 
     /// Takes colour `i` of the terminal's palette as it reported it; whether that
@@ -74,19 +75,8 @@ impl ViewSettings {
         self.palette = p;
         changed && matches!(self.colors, ColorMode::Ansi16 | ColorMode::Ansi256)
     }
-
-    /// Draw options of the viewer.
-    #[must_use]
-    pub fn options(&self) -> DrawOptions {
-        DrawOptions {
-            cull: if self.cull { Cull::Back } else { Cull::None },
-            ..DrawOptions::default()
-        }
-    }
 }
 
-/// Buffers and results of the last rendered frame. Everything is reused; buffers are
-/// resized only when the viewport or the glyph mode changes.
 /// A scene in the viewer: what it is, its pipelines and buffers, and its time.
 #[derive(Debug)]
 pub struct SceneState {
@@ -96,9 +86,23 @@ pub struct SceneState {
     pub time: f32,
 }
 
+impl SceneState {
+    /// A scene with its pipelines, at time 0.
+    #[must_use]
+    pub fn new(scene: Scene) -> Self {
+        let frame = SceneFrame::new(&scene);
+        Self {
+            scene,
+            frame,
+            time: 0.0,
+        }
+    }
+}
+
+/// Buffers and results of the last rendered frame. Everything is reused; buffers are
+/// resized only when the viewport or the glyph mode changes.
 #[derive(Debug)]
 pub struct Viewport {
-    pub frame: StandardFrame,
     pub color: Rgba8,
     pub cells: Vec<CellGlyph>,
     pub cols: u16,
@@ -106,8 +110,8 @@ pub struct Viewport {
     /// Sample target of the last frame.
     pub target: Target,
     pub settings: ViewSettings,
-    /// The camera of the last model frame (the probe must see what was drawn).
-    pub view: StandardView,
+    /// The view of the last frame.
+    pub view: SceneView,
     /// Time spent fitting glyphs.
     pub glyph_time: Duration,
     /// What the wireframe drew.
@@ -117,14 +121,13 @@ pub struct Viewport {
 impl Default for Viewport {
     fn default() -> Self {
         Self {
-            frame: StandardFrame::new(Target::new(1, 1)),
             color: Rgba8::default(),
             cells: Vec::new(),
             cols: 0,
             rows: 0,
             target: Target::new(1, 1),
             settings: ViewSettings::default(),
-            view: StandardView::at(0.0),
+            view: SceneView::default(),
             glyph_time: Duration::ZERO,
             wire: WireCount::default(),
         }
@@ -132,50 +135,27 @@ impl Default for Viewport {
 }
 
 impl Viewport {
-    /// Renders the model for a `cols × rows` cell area and fits every cell's glyph.
-    pub fn render(&mut self, model: &Model, settings: &ViewSettings, cols: u16, rows: u16) {
-        let target = self.lay_out(settings, cols, rows);
-        self.view = settings.view(model);
-        self.wire = self.frame.draw(
-            model,
-            &self.view,
-            target,
-            &settings.options(),
-            settings.mode,
-            &mut self.color,
-        );
-        self.fit_cells();
-    }
-
-    /// Renders a scene (spins at `time` seconds, the camera orbited by the view
-    /// settings' angle and tilt) and fits every cell's glyph; silhouette edges are
+    /// Renders a scene at its time, seen as the view settings say, for a
+    /// `cols × rows` cell area, and fits every cell's glyph; silhouette edges are
     /// drawn over the cells as `/ \ | _`.
-    pub fn render_scene(
+    pub fn render(
         &mut self,
-        scene: &Scene,
-        frame: &mut SceneFrame,
+        s: &mut SceneState,
         settings: &ViewSettings,
         (cols, rows): (u16, u16),
-        time: f32,
     ) {
         let target = self.lay_out(settings, cols, rows);
-        let (sx, sy) = settings.glyphs.dims();
-        let view = SceneView {
-            time,
-            yaw: settings.angle,
-            pitch: settings.tilt,
-            zoom: settings.zoom,
-            pixel_aspect: settings.cell_aspect * sy as f32 / sx as f32,
-        };
-        let start = Instant::now();
-        frame.draw(scene, target, &view);
-        self.frame.timing = [Duration::ZERO, start.elapsed()];
+        self.view = settings.view(s.time);
+        let frame = &mut s.frame;
+        // One colour buffer passes between the two: the frame is drawn into the
+        // viewport's last one, which then holds it.
+        std::mem::swap(&mut self.color, &mut frame.color);
+        frame.draw(&s.scene, target, &self.view);
         self.wire = frame.wire;
-        // The finished frame becomes the viewport's; its old buffer is drawn into next.
         std::mem::swap(&mut self.color, &mut frame.color);
         self.fit_cells();
-        for s in &frame.silhouettes {
-            self.overlay_edge(s.a, s.b);
+        for e in &frame.silhouettes {
+            self.overlay_edge(e.a, e.b);
         }
     }
 

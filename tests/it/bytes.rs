@@ -2,8 +2,8 @@
 //! spinning teapot costs fewer bytes than sending every changed cell, and what the
 //! terminal shows scores within the cache's budget of SSIM.
 
-use termrast::cli::view_cmd::load_model;
 use termrast::fidelity::spin::{SpinConfig, measure};
+use termrast::scene::Scene;
 use termrast::terminal::{ColorMode, GlyphMode};
 
 #[test]
@@ -14,7 +14,7 @@ fn the_cache_sends_fewer_bytes_for_almost_the_same_picture() {
         frames: 5,
         ..SpinConfig::default()
     };
-    let model = load_model("teapot").expect("built in");
+    let model = Scene::for_model("teapot").expect("built in");
     let r = measure(
         &config,
         "teapot",

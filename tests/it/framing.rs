@@ -5,11 +5,8 @@
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 use ratatui::style::Color;
-use termrast::cli::view_cmd::load_model;
 use termrast::raster::Target;
-use termrast::render::standard::{StandardFrame, StandardView};
-use termrast::render::wire::Mode;
-use termrast::render::{DrawOptions, Rgba8};
+use termrast::render::Rgba8;
 use termrast::scene::Scene;
 use termrast::scene::render::{SceneFrame, SceneView};
 use termrast::terminal::{ColorMode, GlyphMode};
@@ -52,7 +49,7 @@ fn settings(glyphs: GlyphMode) -> ViewSettings {
 #[test]
 fn built_in_models_fit_the_view_at_any_angle() {
     for spec in ["teapot", "bunny", "sphere:20000"] {
-        let model = load_model(spec).unwrap();
+        let model = Scene::for_model(spec).unwrap();
         for glyphs in [GlyphMode::Braille, GlyphMode::Blocks] {
             let mut app = App::new(model.clone(), settings(glyphs));
             for (cols, rows) in SIZES {
@@ -84,11 +81,11 @@ fn example_scenes_fit_the_view_as_they_spin() {
     assert!(paths.len() >= 5);
     for path in paths {
         let scene = Scene::load(&path).unwrap();
-        let mut app = App::with_scene(scene, settings(GlyphMode::Braille));
+        let mut app = App::new(scene, settings(GlyphMode::Braille));
         for (cols, rows) in SIZES {
             let mut t = Terminal::new(TestBackend::new(cols, rows)).unwrap();
             for k in 0..6 {
-                app.scene.as_mut().unwrap().time = k as f32 * 1.7;
+                app.scene.time = k as f32 * 1.7;
                 t.draw(|f| app.draw(f)).unwrap();
                 let touched = touched_edges(&t);
                 assert!(
@@ -105,7 +102,7 @@ fn example_scenes_fit_the_view_as_they_spin() {
 /// Other cell shapes (`--cell-aspect`) frame the model the same way.
 #[test]
 fn any_cell_aspect_keeps_the_margin() {
-    let model = load_model("bunny").unwrap();
+    let model = Scene::for_model("bunny").unwrap();
     for aspect in [0.35, 0.6, 1.0] {
         let mut app = App::new(
             model.clone(),
@@ -143,23 +140,20 @@ fn border_is_clear(color: &Rgba8, target: Target) -> bool {
 fn png_frames_keep_the_margin() {
     let targets = [(320, 240), (240, 320), (100, 100), (900, 120)].map(|(w, h)| Target::new(w, h));
     for spec in ["teapot", "bunny", "sphere:20000"] {
-        let model = load_model(spec).unwrap();
+        let scene = Scene::for_model(spec).unwrap();
+        let mut frame = SceneFrame::new(&scene);
         for target in targets {
             for k in 0..4 {
                 let angle = k as f32 * std::f32::consts::FRAC_PI_2;
-                let mut frame = StandardFrame::new(target);
-                let mut color = Rgba8::default();
-                frame.draw(
-                    &model,
-                    &StandardView::framed(&model, 1.0, angle),
-                    target,
-                    &DrawOptions::default(),
-                    Mode::Fill,
-                    &mut color,
-                );
+                let view = SceneView {
+                    yaw: angle,
+                    ..SceneView::default()
+                };
+                frame.draw(&scene, target, &view);
+                let color = &frame.color;
                 assert!(color.0.iter().any(|p| p[3] != 0), "{spec} not drawn at all");
                 assert!(
-                    border_is_clear(&color, target),
+                    border_is_clear(color, target),
                     "{spec} at {}x{}, angle {angle}: touches the edge",
                     target.width,
                     target.height

@@ -3,15 +3,14 @@
 //! ASCII as bright as the model.
 
 use proptest::prelude::*;
-use termrast::cli::view_cmd::{load_model, write_ansi};
+use termrast::cli::view_cmd::write_ansi;
 use termrast::scene::Scene;
-use termrast::scene::render::SceneFrame;
 use termrast::terminal::color::{to_linear, to_srgb};
 use termrast::terminal::fit::{self, N, Repertoire, mask_of, weights_of};
 use termrast::terminal::glyphs::{FitSpace, Sample, fit_cell};
 use termrast::terminal::paint::{self, CELL_HEIGHT, CELL_WIDTH};
 use termrast::terminal::{ColorMode, GlyphMode};
-use termrast::tui::viewport::{ViewSettings, Viewport};
+use termrast::tui::viewport::{SceneState, ViewSettings, Viewport};
 
 /// Every glyph the blocks mode may use, as the issue lists them: space and full block,
 /// the halves, the 16 quadrants, the 64 sextants, the lower and left eighths and the
@@ -250,8 +249,9 @@ fn uniform_cells_show_no_braille_over_the_default_background() {
             ..ViewSettings::default()
         };
         let mut vp = Viewport::default();
-        let mut frame = SceneFrame::new(&scene);
-        vp.render_scene(&scene, &mut frame, &settings, (80, 24), 0.7);
+        let mut state = SceneState::new(scene.clone());
+        state.time = 0.7;
+        vp.render(&mut state, &settings, (80, 24));
         let term = emulate(&vp);
         let (mut uniform, mut full) = (0, 0);
         for cy in 0..vp.rows {
@@ -304,7 +304,7 @@ fn colour_ascii_keeps_the_models_brightness() {
     let text = "[[object]]\nmodel = \"cube.obj\"\nrotation = [30, 40, 0]\n\
                 [object.material]\nlighting = \"flat\"\n[object.effects]\ndepth_test = true\n";
     let scene = Scene::from_text(text, std::path::Path::new("examples/scenes/flat.toml")).unwrap();
-    let teapot = load_model("teapot").unwrap();
+    let teapot = Scene::for_model("teapot").unwrap();
     for (name, fit_space) in [
         ("flat cube", FitSpace::Srgb),
         ("teapot", FitSpace::Srgb),
@@ -317,12 +317,15 @@ fn colour_ascii_keeps_the_models_brightness() {
             ..ViewSettings::default()
         };
         let mut vp = Viewport::default();
-        if name == "teapot" {
-            vp.render(&teapot, &settings, 80, 24);
+        let mut state = if name == "teapot" {
+            SceneState::new(teapot.clone())
         } else {
-            let mut frame = SceneFrame::new(&scene);
-            vp.render_scene(&scene, &mut frame, &settings, (80, 24), 0.7);
+            SceneState::new(scene.clone())
+        };
+        if name != "teapot" {
+            state.time = 0.7;
         }
+        vp.render(&mut state, &settings, (80, 24));
         let term = emulate(&vp);
         let mut bytes = Vec::new();
         write_ansi(&vp, &mut bytes).unwrap();

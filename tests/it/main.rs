@@ -15,6 +15,7 @@ mod hard_cases;
 mod lines;
 mod link;
 mod mesh;
+mod model_frames;
 mod pipeline;
 mod scenes;
 mod terminal;

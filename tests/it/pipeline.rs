@@ -6,16 +6,15 @@ use crate::common::{Direct, draw};
 
 use glam::{Mat4, Vec3, Vec4};
 use termrast::camera::Camera;
-use termrast::mesh::Mesh;
 use termrast::raster::depth::DEPTH_CLEAR;
 use termrast::raster::interp::{Interpolation, Varying};
 use termrast::raster::{Target, Traversal};
 use termrast::render::probe::{DepthOutcome, probe};
 use termrast::render::shaders::Lambert;
-use termrast::render::standard::{Model, StandardFrame, StandardView};
 use termrast::render::target::to_u8;
-use termrast::render::wire::Mode;
-use termrast::render::{Cull, DrawOptions, Isa, Renderer, Rgba8, Shader, VertexCache, transform};
+use termrast::render::{Cull, DrawOptions, Isa, Renderer, Shader, VertexCache, transform};
+use termrast::scene::Scene;
+use termrast::scene::render::{SceneFrame, SceneView};
 
 /// A quad tilted in depth whose attribute is its texture coordinate (u across, v along
 /// the slope), checked against the analytic ray–plane intersection in f64.
@@ -192,33 +191,36 @@ fn interpenetrating_triangles_split_along_their_intersection() {
     assert!(seen[0] > 100 && seen[1] > 100);
 }
 
-fn bunny() -> Mesh {
+/// The benchmark's scene of the bunny (the fixed camera, the model turning).
+fn bunny() -> Scene {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/src/mesh/bunny.obj");
-    let mut m = Mesh::from_spec(path).expect("bunny loads");
-    m.ensure_normals();
-    m
+    Scene::standard(path).expect("bunny loads")
+}
+
+/// The view of the benchmark's frame turned by `angle`, with square pixels.
+fn turned(angle: f32) -> SceneView {
+    SceneView {
+        yaw: angle,
+        ..SceneView::default()
+    }
 }
 
 #[test]
 fn probe_equals_the_framebuffer_for_every_pixel() {
-    let mesh = bunny();
-    let model = Model::new(mesh.clone());
-    assert_eq!(mesh.triangle_count(), 3674);
+    let mut scene = bunny();
+    assert_eq!(scene.objects[0].mesh.triangle_count(), 3674);
     let target = Target::new(120, 90);
-    for (angle, cull) in [(0.7f32, Cull::None), (2.1, Cull::Back)] {
-        let opts = DrawOptions {
-            cull,
-            ..DrawOptions::default()
-        };
-        let mut frame = StandardFrame::new(target);
-        let mut color = Rgba8::default();
-        let view = StandardView::at(angle);
-        frame.draw(&model, &view, target, &opts, Mode::Fill, &mut color);
-        let shader = StandardFrame::shader(&mesh, &view, target);
+    for (angle, cull) in [(0.7f32, false), (2.1, true)] {
+        scene.set_cull(cull);
+        let mut frame = SceneFrame::new(&scene);
+        frame.draw(&scene, target, &turned(angle));
+        assert_eq!(frame.pipelines(), ["lambert"]);
+        let color = &frame.color;
         let mut winners = 0;
         for y in 0..target.height {
             for x in 0..target.width {
-                let p = probe(&frame.cache, &mesh.indices, target, &opts, x, y);
+                let probes = frame.probe(&scene, x, y);
+                let p = &probes[0];
                 let i = (y * target.width + x) as usize;
                 assert_eq!(
                     p.final_depth.to_bits(),
@@ -230,7 +232,9 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
                         let rec = &p.records[w];
                         assert!(rec.eval.covered);
                         assert!(matches!(rec.depth, DepthOutcome::Passed { .. }));
-                        let c = shader.fragment(&rec.varying);
+                        // The colour the probe's record was shaded: the shader's
+                        // scalar fragment stage on the probe's varyings.
+                        let c = rec.varying.expect("a passing fragment is shaded");
                         assert_eq!(
                             color.0[i],
                             [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255],
@@ -255,18 +259,19 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
     }
 }
 
-/// The colour and depth bits of one standard-scene frame.
+/// The colour and depth bits of one frame of the benchmark's scene.
 fn frame_bits(
-    model: &Model,
+    scene: &Scene,
     target: Target,
-    view: &StandardView,
-    opts: &DrawOptions,
+    view: &SceneView,
+    (interpolation, traversal): (Interpolation, Traversal),
     isa: Isa,
 ) -> (Vec<[u8; 4]>, Vec<u32>) {
-    let mut frame = StandardFrame::new(target);
+    let mut frame = SceneFrame::new(scene);
     frame.renderer.isa = isa;
-    let mut color = Rgba8::default();
-    frame.draw(model, view, target, opts, Mode::Fill, &mut color);
+    frame.interpolation = interpolation;
+    frame.traversal = traversal;
+    frame.draw(scene, target, view);
     let depth = frame
         .renderer
         .depth
@@ -274,7 +279,7 @@ fn frame_bits(
         .iter()
         .map(|d| d.to_bits())
         .collect();
-    (color.0, depth)
+    (frame.color.0, depth)
 }
 
 /// Every traversal, on every instruction set the CPU has, gives the same framebuffer bit for bit:
@@ -282,17 +287,12 @@ fn frame_bits(
 /// fallback, the per-pixel path of the others) perform the same f32 operations.
 #[test]
 fn traversals_and_instruction_sets_draw_identical_frames() {
-    let model = Model::new(bunny());
+    let scene = bunny();
     let target = Target::new(160, 120);
-    let view = StandardView::at(0.9);
+    let view = turned(0.9);
     for interpolation in Interpolation::ALL {
         let frame_of = |traversal: Traversal, isa: Isa| {
-            let opts = DrawOptions {
-                traversal,
-                interpolation,
-                ..DrawOptions::default()
-            };
-            frame_bits(&model, target, &view, &opts, isa)
+            frame_bits(&scene, target, &view, (interpolation, traversal), isa)
         };
         let reference = frame_of(Traversal::Scalar, Isa::Baseline);
         assert!(reference.0.iter().filter(|p| p[3] == 255).count() > 3000);
@@ -347,18 +347,15 @@ fn avx512_copy_runs_only_on_targets_a_group_wide_with_lane_shaders() {
 /// reference's frame.
 #[test]
 fn narrow_targets_draw_the_same_frame_with_every_traversal() {
-    let model = Model::new(bunny());
+    let mut scene = bunny();
     // Close up, so the model reaches past every side of the target.
-    let mut view = StandardView::at(0.4);
-    view.camera.eye = Vec3::new(0.0, 0.0, 1.3);
+    let view = turned(0.4);
+    scene.camera.eye = Vec3::new(0.0, 0.0, 1.3);
     for (w, h) in [(1, 1), (3, 5), (7, 6), (8, 4), (9, 9), (15, 12), (17, 10)] {
         let target = Target::new(w, h);
         let frame_of = |traversal: Traversal, isa: Isa| {
-            let opts = DrawOptions {
-                traversal,
-                ..DrawOptions::default()
-            };
-            frame_bits(&model, target, &view, &opts, isa)
+            let options = (Interpolation::Perspective, traversal);
+            frame_bits(&scene, target, &view, options, isa)
         };
         let reference = frame_of(Traversal::Scalar, Isa::Baseline);
         let covered = reference.0.iter().filter(|p| p[3] == 255).count();
@@ -435,28 +432,19 @@ fn huge_triangles_take_the_i64_lanes_and_agree() {
 
 #[test]
 fn teapot_luminance_snapshot() {
-    let mut mesh = Mesh::teapot();
-    mesh.ensure_normals();
+    let scene = Scene::standard("teapot").unwrap();
     let target = Target::new(64, 32);
-    let mut frame = StandardFrame::new(target);
-    let mut color = Rgba8::default();
+    let mut frame = SceneFrame::new(&scene);
     // Pixels twice as tall as wide, like terminal cells.
-    let view = StandardView {
+    let view = SceneView {
         pixel_aspect: 0.5,
-        ..StandardView::at(0.6)
+        ..turned(0.6)
     };
-    frame.draw(
-        &Model::new(mesh.clone()),
-        &view,
-        target,
-        &DrawOptions::default(),
-        Mode::Fill,
-        &mut color,
-    );
+    frame.draw(&scene, target, &view);
     // The teapot is grey, so any channel is its luminance.
     let ramp = b" .:-=+*#%@";
     let mut text = String::new();
-    for row in color.0.chunks(64) {
+    for row in frame.color.0.chunks(64) {
         for p in row {
             let l = f32::from(p[1]) / 255.0;
             text.push(ramp[((l * 9.0).round() as usize).min(9)] as char);
@@ -468,23 +456,12 @@ fn teapot_luminance_snapshot() {
 
 #[test]
 fn transform_and_cull_counts() {
-    let mesh = bunny();
+    let mut scene = bunny();
+    scene.set_cull(true);
     let target = Target::new(160, 120);
-    let mut frame = StandardFrame::new(target);
-    let mut color = Rgba8::default();
-    let opts = DrawOptions {
-        cull: Cull::Back,
-        ..DrawOptions::default()
-    };
-    frame.draw(
-        &Model::new(mesh.clone()),
-        &StandardView::at(0.0),
-        target,
-        &opts,
-        Mode::Fill,
-        &mut color,
-    );
-    let s = frame.renderer.stats;
+    let mut frame = SceneFrame::new(&scene);
+    frame.draw(&scene, target, &turned(0.0));
+    let s = frame.stats;
     assert_eq!(s.triangles, 3674);
     assert_eq!(s.drawn + s.culled + s.rejected, s.triangles);
     // A closed mesh shows roughly half its faces.

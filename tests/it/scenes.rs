@@ -4,12 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-use termrast::cli::view_cmd::load_model;
 use termrast::counters::{self, Stage};
 use termrast::raster::Target;
-use termrast::render::standard::{StandardFrame, StandardView};
-use termrast::render::wire::Mode;
-use termrast::render::{DrawOptions, Rgba8};
 use termrast::scene::render::{SceneFrame, SceneView};
 use termrast::scene::{Scene, SceneError};
 
@@ -300,8 +296,8 @@ fn render_plan_and_bad_scene_from_the_command_line() {
 
 /// Pass: an object whose plan is exactly the standard one (a model's default scene,
 /// and the coloured lit teapot) is drawn by the lane-code Lambert pipeline, and a
-/// model's scene has the bits of the model's standard frame seen the same way; any
-/// other plan takes the packed shader.
+/// model's scene has the bits the model's standard frame had seen the same way (as
+/// recorded in `model_frames`); any other plan takes the packed shader.
 #[test]
 fn the_standard_plan_takes_the_lambert_pipeline() {
     let target = Target::new(160, 120);
@@ -310,19 +306,14 @@ fn the_standard_plan_takes_the_lambert_pipeline() {
         let mut frame = SceneFrame::new(&scene);
         assert_eq!(frame.pipelines(), ["lambert"], "{spec}");
         frame.draw(&scene, target, &SceneView::default());
-        let model = load_model(spec).unwrap();
-        let mut standard = StandardFrame::new(target);
-        let mut color = Rgba8::default();
-        standard.draw(
-            &model,
-            &StandardView::framed(&model, 1.0, 0.0),
-            target,
-            &DrawOptions::default(),
-            Mode::Fill,
-            &mut color,
+        let color = &frame.color.0;
+        assert!(color.iter().filter(|p| p[3] == 255).count() > 1000);
+        let recorded = crate::model_frames::recorded_colour(
+            spec,
+            "framed a0 t0 z1 pa1 Fill Perspective wide 160x120",
         );
-        assert!(color.0.iter().filter(|p| p[3] == 255).count() > 1000);
-        assert!(frame.color.0 == color.0, "{spec}: the frames differ");
+        let hash = crate::model_frames::hash(color.iter().flatten().copied());
+        assert_eq!(hash, recorded, "{spec}: the frames differ");
     }
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
     for (file, pipelines) in [
@@ -339,4 +330,64 @@ fn the_standard_plan_takes_the_lambert_pipeline() {
     )
     .unwrap();
     assert_eq!(SceneFrame::new(&fog).pipelines(), ["packed"]);
+}
+
+/// Pass: `fill = false` draws an object's edges and nothing of its triangles: the plan
+/// says so, there is no depth buffer, every pixel drawn is a wire pixel, and no
+/// fragment is depth-tested or lit. Filling it again (the viewer's `w`) gives the plan
+/// and the bits of the scene loaded filled; edges a plan did not load are computed
+/// when a wireframe is turned on, the same as loaded.
+#[test]
+fn fill_off_draws_only_edges() {
+    use termrast::render::target::to_u8;
+    use termrast::render::wire::{Mode, WIRE_COLOR};
+    let text = |effects: &str| {
+        format!(
+            "[[object]]\nmodel = \"teapot\"\n[object.material]\nlighting = \"lambert\"\n\
+             [object.effects]\ndepth_test = true\n{effects}"
+        )
+    };
+    let load = |effects: &str| Scene::from_text(&text(effects), Path::new("w.toml")).unwrap();
+    let mut scene = load("wireframe = true\nfill = false\n");
+    let plan = scene.plan.to_string();
+    assert!(
+        plan.contains("triangles: skipped (fill = false")
+            && plan.contains("depth test: skipped (fill = false")
+            && plan.contains("lighting: skipped (fill = false")
+            && plan.contains("wireframe: on (every edge")
+            && !scene.plan.depth_buffer,
+        "{plan}"
+    );
+    assert_eq!(scene.mode(), Some(Mode::Wire));
+    let target = Target::new(96, 64);
+    let mut frame = SceneFrame::new(&scene);
+    counters::reset();
+    frame.draw(&scene, target, &SceneView::default());
+    let c = counters::snapshot();
+    assert_eq!(
+        [Stage::DepthTests, Stage::Lighting, Stage::DepthClears].map(|s| c.get(s)),
+        [0; 3]
+    );
+    assert!(c.get(Stage::WireEdges) > 0 && !frame.renderer.has_depth());
+    let wire = WIRE_COLOR.to_array().map(to_u8);
+    let drawn: Vec<_> = frame.color.0.iter().filter(|p| p[3] == 255).collect();
+    assert!(drawn.len() > 300 && drawn.iter().all(|p| p[..3] == wire));
+    assert!(frame.probe(&scene, 48, 32)[0].records.is_empty());
+
+    scene.set_mode(Mode::FillWire);
+    let filled = load("wireframe = true\n");
+    assert_eq!(scene.plan, filled.plan);
+    frame.draw(&scene, target, &SceneView::default());
+    let mut reference = SceneFrame::new(&filled);
+    reference.draw(&filled, target, &SceneView::default());
+    assert!(frame.renderer.has_depth());
+    assert!(frame.color.0 == reference.color.0, "the frames differ");
+
+    let mut plain = load("");
+    assert!(
+        plain.objects[0].edges.is_empty(),
+        "no edges without a wireframe"
+    );
+    plain.set_mode(Mode::Wire);
+    assert_eq!(plain.objects[0].edges, filled.objects[0].edges);
 }

@@ -2,8 +2,8 @@
 
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
-use termrast::render::standard::Model;
 use termrast::render::wire::Mode;
+use termrast::scene::Scene;
 use termrast::terminal::glyphs::{FitSpace, Sample, braille, fit_cell, sextant};
 use termrast::terminal::{ColorMode, GlyphMode, Palette};
 use termrast::tui::app::App;
@@ -188,10 +188,8 @@ fn colour_detection_table() {
     );
 }
 
-fn teapot() -> Model {
-    let mut m = termrast::mesh::Mesh::teapot();
-    m.ensure_normals();
-    Model::new(m)
+fn teapot() -> Scene {
+    Scene::for_model("teapot").unwrap()
 }
 
 fn app(glyphs: GlyphMode) -> App {
@@ -228,11 +226,11 @@ fn viewport_snapshots_in_every_glyph_mode() {
 fn inspector_and_line_panel_snapshots() {
     let mut a = app(GlyphMode::Quadrant);
     a.inspect = true;
-    a.settings.mode = Mode::FillWire;
+    a.scene.scene.set_mode(Mode::FillWire);
     a.cursor = (31, 19);
     let mut t = Terminal::new(TestBackend::new(120, 40)).unwrap();
     t.draw(|f| a.draw(f)).unwrap();
-    let text = inspector_text(&a.viewport, &a.model, a.cursor.0, a.cursor.1, 0).plain();
+    let text = inspector_text(&a.viewport, &a.scene, a.cursor.0, a.cursor.1, 0).plain();
     assert!(
         [
             "F01", "F02", "F03", "area2", " u ", " v ", " w ", "1/w", "depth", "block"
@@ -243,7 +241,7 @@ fn inspector_and_line_panel_snapshots() {
     );
     insta::assert_snapshot!("inspector_cell_31_19", text);
     let (focus, sl) =
-        line_at_sample(&a.viewport, &a.model, None, (31, 19, 0)).expect("a line near the cell");
+        line_at_sample(&a.viewport, &a.scene, (31, 19, 0)).expect("a line near the cell");
     let panel = line_text(focus, &sl).plain();
     assert!(
         ["octant", "dx", "dy", "incrE", "incrNE", " d "]
@@ -315,7 +313,7 @@ fn the_line_panel_works_for_scenes() {
     let scene =
         termrast::scene::Scene::load(std::path::Path::new("examples/scenes/lit-teapot.toml"))
             .unwrap();
-    let mut a = App::with_scene(
+    let mut a = App::new(
         scene,
         ViewSettings {
             glyphs: GlyphMode::Blocks,
@@ -341,6 +339,41 @@ fn the_line_panel_works_for_scenes() {
     assert!(a.line_focus.is_some_and(|f| f.object == Some(0)));
 }
 
+/// `w` and `b` act on a scene file's objects: the status line and the plan follow.
+#[test]
+fn w_and_b_change_what_a_scene_draws() {
+    use ratatui::crossterm::event::KeyCode;
+    let scene =
+        termrast::scene::Scene::load(std::path::Path::new("examples/scenes/lit-teapot.toml"))
+            .unwrap();
+    let mut a = App::new(
+        scene,
+        ViewSettings {
+            glyphs: GlyphMode::Blocks,
+            ..ViewSettings::default()
+        },
+    );
+    let mut t = Terminal::new(TestBackend::new(200, 40)).unwrap();
+    t.draw(|f| a.draw(f)).unwrap();
+    let s = status_line(&t);
+    assert!(s.contains("fill no cull"), "{s}");
+    key(&mut a, KeyCode::Char('w'));
+    key(&mut a, KeyCode::Char('b'));
+    t.draw(|f| a.draw(f)).unwrap();
+    let s = status_line(&t);
+    let lines: u64 = s
+        .split_once("wire ")
+        .and_then(|(_, r)| r.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .expect("a line count");
+    assert!(lines > 100 && s.contains(" cull"), "{s}");
+    let plan = a.scene.scene.plan.to_string();
+    assert!(
+        plan.contains("wireframe: on") && plan.contains("back-face culling: on"),
+        "{plan}"
+    );
+}
+
 /// The plan overlay wraps long lines instead of cutting them.
 #[test]
 fn the_plan_overlay_wraps() {
@@ -349,7 +382,7 @@ fn the_plan_overlay_wraps() {
         termrast::scene::Scene::load(std::path::Path::new("examples/scenes/phong-bunny.toml"))
             .unwrap();
     let plan = scene.plan.to_string();
-    let mut a = App::with_scene(scene, ViewSettings::default());
+    let mut a = App::new(scene, ViewSettings::default());
     let mut t = Terminal::new(TestBackend::new(50, 60)).unwrap();
     key(&mut a, KeyCode::Char('p'));
     t.draw(|f| a.draw(f)).unwrap();

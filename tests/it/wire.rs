@@ -3,10 +3,11 @@
 use glam::{Vec3, Vec4};
 use termrast::mesh::Mesh;
 use termrast::raster::Target;
-use termrast::render::standard::{Model, StandardFrame, StandardView, WIRE_COLOR};
 use termrast::render::target::to_u8;
-use termrast::render::wire::{Mode, draw_wireframe, probe_lines, unique_edges};
+use termrast::render::wire::{Mode, WIRE_COLOR, draw_wireframe, unique_edges};
 use termrast::render::{DrawOptions, Renderer, Rgba8, VertexCache, transform};
+use termrast::scene::Scene;
+use termrast::scene::render::{SceneFrame, SceneView};
 
 use crate::common::Direct;
 
@@ -117,9 +118,7 @@ fn hidden_lines_behind_a_face_are_removed() {
 
 #[test]
 fn line_probe_explains_every_wire_pixel() {
-    let mut mesh = Mesh::teapot();
-    mesh.ensure_normals();
-    let model = Model::new(mesh);
+    let mut scene = Scene::standard("teapot").unwrap();
     let target = Target::new(96, 64);
     let wire = [
         to_u8(WIRE_COLOR.x),
@@ -128,24 +127,25 @@ fn line_probe_explains_every_wire_pixel() {
         255,
     ];
     for mode in [Mode::Wire, Mode::FillWire] {
-        let mut frame = StandardFrame::new(target);
-        let mut color = Rgba8::default();
-        let view = StandardView::at(0.4);
-        frame.draw(
-            &model,
-            &view,
-            target,
-            &DrawOptions::default(),
-            mode,
-            &mut color,
-        );
-        let depth = mode.fills().then_some(&frame.renderer.depth);
+        scene.set_mode(mode);
+        let mut frame = SceneFrame::new(&scene);
+        let view = SceneView {
+            yaw: 0.4,
+            ..SceneView::default()
+        };
+        frame.draw(&scene, target, &view);
+        // Hidden lines are tested against the filled mesh's depth.
+        assert_eq!(frame.renderer.has_depth(), mode.fills());
         let mut lit = 0;
         for y in 0..target.height {
             for x in 0..target.width {
-                let hits = probe_lines(&frame.cache, &model.edges, target, depth, x, y);
+                let hits: Vec<_> = frame
+                    .probe_lines(&scene, x, y)
+                    .into_iter()
+                    .map(|(_, h)| h)
+                    .collect();
                 let visible: Vec<_> = hits.iter().filter(|h| h.visible).collect();
-                let is_wire = color.0[(y * target.width + x) as usize] == wire;
+                let is_wire = frame.color.0[(y * target.width + x) as usize] == wire;
                 assert_eq!(is_wire, !visible.is_empty(), "({x},{y}) in {mode:?}");
                 for h in &hits {
                     assert_eq!(h.step.pixel, (i64::from(x), i64::from(y)));

@@ -1,27 +1,36 @@
 //! A scene's frame: the camera, the buffers the plan asks for, every object drawn in
 //! order, supersampling resolved.
 
-use glam::{Mat3, Vec3};
+use std::time::{Duration, Instant};
+
+use glam::{Mat3, Mat4, Vec3};
 
 use super::*;
+use crate::camera::Camera;
 use crate::counters::{self, Stage};
-use crate::raster::Target;
+use crate::raster::interp::Interpolation;
 use crate::raster::samples::grid_side;
+use crate::raster::{Target, Traversal};
 use crate::render::probe::Probe;
-use crate::render::wire::{ScreenLine, WireCount};
-use crate::render::{DrawStats, Renderer, Rgba8};
-use crate::scene::Scene;
-use crate::scene::plan::VaryingSet;
+use crate::render::wire::{LineHit, ScreenLine, WireCount};
+use crate::render::{DrawOptions, DrawStats, Renderer, Rgba8};
+use crate::scene::plan::{ObjectPlan, VaryingSet};
+use crate::scene::{Rig, Scene, SceneObject};
+
+/// A probe of one object at a pixel, each record carrying the colour its fragment
+/// was shaded (if it passed the depth test).
+pub type ShadedProbe = Probe<Option<Vec3>>;
 
 /// Where a scene is seen from in one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SceneView {
     /// Seconds since the start (spins).
     pub time: f32,
-    /// Orbit of the camera about its target: radians about y, then about x.
+    /// Radians about y, then about x: of the camera about its target
+    /// ([`Rig::Orbit`]), or of the objects about the origin ([`Rig::Turntable`]).
     pub yaw: f32,
     pub pitch: f32,
-    /// Camera distance divisor (1 = as in the file).
+    /// Camera distance divisor (1 = as loaded): see [`Rig`].
     pub zoom: f32,
     /// Pixel width over height of the target's samples.
     pub pixel_aspect: f32,
@@ -51,6 +60,16 @@ pub struct SceneFrame {
     /// Counters of the last frame, all objects.
     pub stats: DrawStats,
     pub wire: WireCount,
+    /// How every object's attributes are interpolated, and the traversal that walks
+    /// its triangles (all give the same coverage): the rest of the draw options
+    /// come from each object's plan.
+    pub interpolation: Interpolation,
+    pub traversal: Traversal,
+    /// Time of the last frame's vertex stage, and of the rest of its drawing
+    /// (coverage, depth and shading are one fused loop, so they are timed together).
+    pub timing: [Duration; 2],
+    /// The last frame's context, for the probe (its lights are the scene's).
+    ctx: Option<FrameCtx<'static>>,
 }
 
 impl std::fmt::Debug for SceneFrame {
@@ -78,6 +97,25 @@ impl SceneFrame {
             silhouettes: Vec::new(),
             stats: DrawStats::default(),
             wire: WireCount::default(),
+            interpolation: Interpolation::Perspective,
+            traversal: Traversal::Wide,
+            timing: Default::default(),
+            ctx: None,
+        }
+    }
+
+    /// The draw options of an object: its plan's depth test and culling, this
+    /// frame's interpolation and traversal.
+    #[must_use]
+    pub fn draw_options(&self, plan: &ObjectPlan) -> DrawOptions {
+        draw_options(plan, self.base_options())
+    }
+
+    fn base_options(&self) -> DrawOptions {
+        DrawOptions {
+            interpolation: self.interpolation,
+            traversal: self.traversal,
+            ..DrawOptions::default()
         }
     }
 
@@ -96,26 +134,25 @@ impl SceneFrame {
 
     /// Draws a frame of `target` samples.
     pub fn draw(&mut self, scene: &Scene, target: Target, view: &SceneView) {
+        let start = Instant::now();
         let plan = &scene.plan;
         let side = grid_side(plan.samples);
         let fine = Target::new(target.width * side, target.height * side);
-        let cam = &scene.camera;
-        let orbit = Mat3::from_rotation_y(view.yaw) * Mat3::from_rotation_x(view.pitch);
-        let eye = cam.target + orbit * (cam.eye - cam.target) / view.zoom.max(0.05);
-        let camera = crate::camera::Camera {
-            eye,
-            up: orbit * cam.up,
-            ..*cam
-        };
-        let view_proj =
-            camera.projection(fine.width, fine.height, view.pixel_aspect) * camera.view();
+        let (cam, turn) = view_of(scene, view);
+        let cam = &cam;
+        let eye = cam.eye;
+        let view_proj = cam.projection(fine.width, fine.height, view.pixel_aspect) * cam.view();
         let forward = (cam.target - eye).normalize_or_zero();
+        let model = |o: &SceneObject| {
+            let m = o.desc.model_matrix(view.time);
+            turn.map_or(m, |t| t * m)
+        };
         // Depth shading spans the objects' bounding spheres along the view.
         let depth_range = scene
             .objects
             .iter()
             .map(|o| {
-                let c = o.desc.model_matrix(view.time).transform_point3(Vec3::ZERO);
+                let c = model(o).transform_point3(Vec3::ZERO);
                 let r = o.desc.scale * 3f32.sqrt();
                 let d = (c - eye).dot(forward);
                 (d - r, d + r)
@@ -131,6 +168,7 @@ impl SceneFrame {
         } else {
             (cam.near, cam.far)
         };
+        let base = self.base_options();
         let ctx = FrameCtx {
             view_proj,
             eye,
@@ -138,7 +176,9 @@ impl SceneFrame {
             lights: &scene.lights,
             depth_range,
             time: view.time,
+            turn,
         };
+        self.ctx = Some(ctx.without_lights());
         let color = if side > 1 {
             &mut self.fine
         } else {
@@ -147,13 +187,15 @@ impl SceneFrame {
         self.renderer
             .begin_frame_with(fine, color, scene.background, plan.depth_buffer);
         let mut stats = DrawStats::default();
+        let mut vertex = Duration::ZERO;
         for ((obj, op), pipe) in scene
             .objects
             .iter()
             .zip(&plan.objects)
             .zip(&mut self.pipelines)
         {
-            pipe.draw(obj, op, ctx, &mut self.renderer, color);
+            let opts = draw_options(op, base);
+            vertex += pipe.draw(obj, op, ctx, &opts, &mut self.renderer, color);
             stats += self.renderer.stats;
             self.renderer.stats = DrawStats::default();
         }
@@ -167,7 +209,7 @@ impl SceneFrame {
         self.silhouettes.clear();
         for ((obj, op), pipe) in scene.objects.iter().zip(&plan.objects).zip(&self.pipelines) {
             if op.silhouette {
-                let depth = op.depth_test.then_some((&self.renderer.depth, side));
+                let depth = op.writes_depth().then_some((&self.renderer.depth, side));
                 pipe.silhouettes(obj, target, depth, &mut self.silhouettes);
             }
         }
@@ -182,12 +224,22 @@ impl SceneFrame {
             );
         }
         self.stats = stats;
+        self.timing = [vertex, start.elapsed().saturating_sub(vertex)];
     }
 
-    /// Probes sample `(x, y)` of the last frame (without supersampling) for every
-    /// object in draw order, the depth carried from one object to the next.
+    /// Probes pixel `(x, y)` of the last frame's (supersampled) target for every
+    /// object in draw order, the depth carried from one object to the next; each
+    /// record carries the colour its fragment was shaded, if it passed. Empty before
+    /// the first frame.
     #[must_use]
-    pub fn probe(&self, scene: &Scene, x: u32, y: u32) -> Vec<Probe<()>> {
+    pub fn probe(&self, scene: &Scene, x: u32, y: u32) -> Vec<ShadedProbe> {
+        let Some(ctx) = self.ctx else {
+            return Vec::new();
+        };
+        let ctx = FrameCtx {
+            lights: &scene.lights,
+            ..ctx
+        };
         let mut stored = crate::raster::depth::DEPTH_CLEAR;
         let mut out = Vec::new();
         for ((obj, op), pipe) in scene
@@ -196,9 +248,32 @@ impl SceneFrame {
             .zip(&scene.plan.objects)
             .zip(&self.pipelines)
         {
-            let p = pipe.probe(obj, op, self.renderer.target, x, y, stored);
+            let opts = self.draw_options(op);
+            let p = pipe.probe(obj, op, ctx, &opts, self.renderer.target, (x, y), stored);
             stored = p.final_depth;
             out.push(p);
+        }
+        out
+    }
+
+    /// Every drawn wireframe line through pixel `(x, y)` of the last frame's
+    /// (supersampled) target, by object, tested as it was drawn.
+    #[must_use]
+    pub fn probe_lines(&self, scene: &Scene, x: u32, y: u32) -> Vec<(usize, LineHit)> {
+        let depth = self.renderer.has_depth().then_some(&self.renderer.depth);
+        let mut out = Vec::new();
+        for (i, ((obj, op), pipe)) in scene
+            .objects
+            .iter()
+            .zip(&scene.plan.objects)
+            .zip(&self.pipelines)
+            .enumerate()
+        {
+            if op.wireframe {
+                let depth = depth.filter(|_| op.hidden_lines);
+                let hits = pipe.probe_lines(obj, self.renderer.target, depth, x, y);
+                out.extend(hits.into_iter().map(|h| (i, h)));
+            }
         }
         out
     }
@@ -246,6 +321,29 @@ impl SceneFrame {
         self.pipelines
             .get(object)?
             .project_edge(edge, self.renderer.target)
+    }
+}
+
+/// The camera of a frame, and the turntable's rotation of the objects if the scene
+/// is on one.
+fn view_of(scene: &Scene, view: &SceneView) -> (Camera, Option<Mat4>) {
+    let cam = &scene.camera;
+    match scene.rig {
+        Rig::Orbit => {
+            let orbit = Mat3::from_rotation_y(view.yaw) * Mat3::from_rotation_x(view.pitch);
+            let eye = cam.target + orbit * (cam.eye - cam.target) / view.zoom.max(0.05);
+            let camera = Camera {
+                eye,
+                up: orbit * cam.up,
+                ..*cam
+            };
+            (camera, None)
+        }
+        Rig::Turntable { framing } => {
+            let camera = framing.map_or(*cam, |r| Camera::framing(r, view.zoom));
+            let turn = Mat4::from_rotation_x(view.pitch) * Mat4::from_rotation_y(view.yaw);
+            (camera, Some(turn))
+        }
     }
 }
 

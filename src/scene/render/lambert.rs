@@ -45,7 +45,7 @@ impl Shading for StandardLambert {
     type Instance<'a> = Lambert<'a>;
 
     fn shader<'a>(obj: &'a SceneObject, _plan: &'a ObjectPlan, ctx: FrameCtx<'a>) -> Lambert<'a> {
-        let model = obj.desc.model_matrix(ctx.time);
+        let model = ctx.model(obj);
         Lambert::new(&obj.mesh, model, ctx.view_proj)
             .with_material(obj.desc.material.color, STANDARD_AMBIENT)
     }

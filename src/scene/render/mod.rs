@@ -1,7 +1,8 @@
 //! Rendering a scene by its plan.
 //!
-//! An object's varyings are the attributes its plan needs ([`VaryingSet`]: normal,
-//! world position, colour, uv), packed into an array of floats by a [`Layout`]
+//! An object's varyings are the attributes its plan needs
+//! ([`VaryingSet`](crate::scene::plan::VaryingSet): normal, world position, colour,
+//! uv), packed into an array of floats by a [`Layout`]
 //! chosen when the scene is loaded. An attribute the plan leaves out is neither
 //! computed in the vertex stage nor read by the fragment stage. The draw loop is
 //! compiled for a few array widths ([`PACKED_WIDTHS`]), not for every attribute set,

@@ -2,17 +2,20 @@
 //! else the packed shader at the narrowest width that holds its varyings), its vertex
 //! cache, and what it draws (fill, wireframe, silhouettes, the probe).
 
-use glam::{Vec2, Vec4};
+use std::time::{Duration, Instant};
+
+use glam::{Vec2, Vec3, Vec4};
 
 use super::*;
 use crate::counters::{self, Stage};
 use crate::raster::Target;
 use crate::raster::depth::{DepthBuffer, DepthState};
 use crate::raster::interp::Varying;
-use crate::render::probe::{Probe, probe_from};
-use crate::render::standard::WIRE_COLOR;
+use crate::render::probe::{DepthOutcome, Probe, probe_from};
+
 use crate::render::wire::{
-    ScreenLine, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under, project_edge,
+    LineHit, ScreenLine, WIRE_COLOR, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under,
+    probe_lines, project_edge,
 };
 use crate::render::{
     Cull, DrawOptions, Renderer, Rgba8, Shader, VertexCache, ndc_to_screen, transform,
@@ -29,15 +32,17 @@ pub struct Silhouette {
 
 /// One object's pipeline: its monomorphized shader and its vertex cache.
 pub trait ObjectPipeline {
-    /// Transforms and draws the object.
+    /// Transforms the object and draws its triangles (if its plan fills them) with
+    /// `opts`; returns the time the vertex stage took.
     fn draw(
         &mut self,
         obj: &SceneObject,
         plan: &ObjectPlan,
         ctx: FrameCtx<'_>,
+        opts: &DrawOptions,
         r: &mut Renderer,
         color: &mut Rgba8,
-    );
+    ) -> Duration;
     /// Draws the object's edges.
     fn wireframe(
         &self,
@@ -54,16 +59,29 @@ pub trait ObjectPipeline {
         depth: Option<(&DepthBuffer, u32)>,
         out: &mut Vec<Silhouette>,
     );
-    /// The raster state of a pixel for this object, continuing from `stored` depth.
+    /// The raster state of a pixel for this object as drawn with `opts` in the frame
+    /// of `ctx`, continuing from `stored` depth; each record carries the colour its
+    /// fragment was shaded (if it passed the depth test).
+    #[allow(clippy::too_many_arguments)]
     fn probe(
         &self,
         obj: &SceneObject,
         plan: &ObjectPlan,
+        ctx: FrameCtx<'_>,
+        opts: &DrawOptions,
         target: Target,
+        pixel: (u32, u32),
+        stored: f32,
+    ) -> Probe<Option<Vec3>>;
+    /// Every one of the object's edges whose line draws pixel `(x, y)`.
+    fn probe_lines(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<&DepthBuffer>,
         x: u32,
         y: u32,
-        stored: f32,
-    ) -> Probe<()>;
+    ) -> Vec<LineHit>;
     /// The varying set this pipeline was compiled for.
     fn varyings(&self) -> VaryingSet;
     /// Which shading it draws with ([`Shading::NAME`]).
@@ -82,9 +100,10 @@ pub trait ObjectPipeline {
     fn project_edge(&self, edge: [u32; 2], target: Target) -> Option<ScreenLine>;
 }
 
-/// The draw options an object's plan asks for.
+/// The draw options an object's plan asks for (its depth test and culling), over
+/// `base` (the frame's interpolation and traversal).
 #[must_use]
-pub fn draw_options(plan: &ObjectPlan) -> DrawOptions {
+pub fn draw_options(plan: &ObjectPlan, base: DrawOptions) -> DrawOptions {
     DrawOptions {
         depth: if plan.depth_test {
             DepthState::default()
@@ -92,7 +111,7 @@ pub fn draw_options(plan: &ObjectPlan) -> DrawOptions {
             DepthState::OFF
         },
         cull: if plan.cull { Cull::Back } else { Cull::None },
-        ..DrawOptions::default()
+        ..base
     }
 }
 
@@ -143,20 +162,20 @@ impl<S: Shading> ObjectPipeline for Pipeline<S> {
         obj: &SceneObject,
         plan: &ObjectPlan,
         ctx: FrameCtx<'_>,
+        opts: &DrawOptions,
         r: &mut Renderer,
         color: &mut Rgba8,
-    ) {
+    ) -> Duration {
+        let start = Instant::now();
         let shader = S::shader(obj, plan, ctx);
         transform(&shader, obj.mesh.positions.len(), &mut self.cache);
-        let shaded = r.stats.shaded;
-        r.draw(
-            &shader,
-            &self.cache,
-            &obj.mesh.indices,
-            &draw_options(plan),
-            color,
-        );
-        S::count_work(obj, r.stats.shaded - shaded);
+        let vertex = start.elapsed();
+        if plan.fill {
+            let shaded = r.stats.shaded;
+            r.draw(&shader, &self.cache, &obj.mesh.indices, opts, color);
+            S::count_work(obj, r.stats.shaded - shaded);
+        }
+        vertex
     }
 
     fn wireframe(
@@ -241,29 +260,51 @@ impl<S: Shading> ObjectPipeline for Pipeline<S> {
         &self,
         obj: &SceneObject,
         plan: &ObjectPlan,
+        ctx: FrameCtx<'_>,
+        opts: &DrawOptions,
         target: Target,
-        x: u32,
-        y: u32,
+        (x, y): (u32, u32),
         stored: f32,
-    ) -> Probe<()> {
-        // The trait object cannot return this pipeline's varying type: the records keep
-        // everything else.
-        let p = probe_from(
-            &self.cache,
-            &obj.mesh.indices,
-            target,
-            &draw_options(plan),
-            x,
-            y,
-            stored,
-        );
+    ) -> Probe<Option<Vec3>> {
+        if !plan.fill {
+            // Nothing of it was rasterized.
+            return Probe {
+                x,
+                y,
+                records: Vec::new(),
+                winner: None,
+                final_depth: stored,
+            };
+        }
+        let p = probe_from(&self.cache, &obj.mesh.indices, target, opts, x, y, stored);
+        // The trait object cannot return this pipeline's varying type: each record
+        // keeps the colour shaded from it instead.
+        let shader = S::shader(obj, plan, ctx);
         Probe {
             x: p.x,
             y: p.y,
-            records: p.records.into_iter().map(|r| r.map(|_| ())).collect(),
+            records: p
+                .records
+                .into_iter()
+                .map(|r| {
+                    let passed = matches!(r.depth, DepthOutcome::Passed { .. });
+                    r.map(|v| passed.then(|| shader.fragment(&v)))
+                })
+                .collect(),
             winner: p.winner,
             final_depth: p.final_depth,
         }
+    }
+
+    fn probe_lines(
+        &self,
+        obj: &SceneObject,
+        target: Target,
+        depth: Option<&DepthBuffer>,
+        x: u32,
+        y: u32,
+    ) -> Vec<LineHit> {
+        probe_lines(&self.cache, &obj.edges, target, depth, x, y)
     }
 
     fn varyings(&self) -> VaryingSet {

@@ -82,6 +82,33 @@ pub struct FrameCtx<'a> {
     /// View depths mapped to bright and dark by depth shading.
     pub depth_range: (f32, f32),
     pub time: f32,
+    /// The turntable's rotation of every object ([`Rig::Turntable`](crate::scene::Rig::Turntable)), if any.
+    pub turn: Option<Mat4>,
+}
+
+impl FrameCtx<'_> {
+    /// An object's model matrix in this frame: its own at the frame's time, turned on
+    /// the turntable.
+    #[must_use]
+    pub fn model(&self, obj: &SceneObject) -> Mat4 {
+        let m = obj.desc.model_matrix(self.time);
+        self.turn.map_or(m, |t| t * m)
+    }
+
+    /// The same context without its lights, to keep past the frame (the probe gives
+    /// them back).
+    #[must_use]
+    pub fn without_lights(&self) -> FrameCtx<'static> {
+        FrameCtx {
+            view_proj: self.view_proj,
+            eye: self.eye,
+            forward: self.forward,
+            lights: &[],
+            depth_range: self.depth_range,
+            time: self.time,
+            turn: self.turn,
+        }
+    }
 }
 
 /// The shader of one object, its varyings packed in `K` floats by [`Layout`].
@@ -99,7 +126,7 @@ impl<'a, const K: usize> ObjectShader<'a, K> {
     /// The shader for an object at this frame.
     #[must_use]
     pub fn new(obj: &'a SceneObject, plan: &'a ObjectPlan, ctx: FrameCtx<'a>) -> Self {
-        let model = obj.desc.model_matrix(ctx.time);
+        let model = ctx.model(obj);
         let layout = Layout::new(plan.varyings);
         debug_assert!(layout.len <= K);
         Self {

@@ -268,23 +268,7 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 /// row-major 4 × 8) in summed squared error.
 #[must_use]
 pub fn fit<'r>(rep: &'r Repertoire, x: &[[f32; 3]; N]) -> Fit<'r> {
-    let mut sq = 0.0;
-    // Row `r`'s subset sums, each adding its samples from the highest column down.
-    let rs: [[[f32; 3]; 16]; SY] = std::array::from_fn(|r| {
-        let px = &x[r * SX..r * SX + SX];
-        for p in px {
-            sq += dot(*p, *p);
-        }
-        std::array::from_fn(|s| {
-            let mut acc = [0.0; 3];
-            for (i, p) in px.iter().enumerate().rev() {
-                if s >> i & 1 == 1 {
-                    acc = add(acc, *p);
-                }
-            }
-            acc
-        })
-    });
+    let (rs, sq) = subset_sums(x);
     let t = rs.iter().fold([0.0; 3], |a, row| add(a, row[15]));
     let tt = dot(t, t);
     let uniform_score = tt / N as f32;
@@ -301,6 +285,28 @@ pub fn fit<'r>(rep: &'r Repertoire, x: &[[f32; 3]; N]) -> Fit<'r> {
         }
     }
     finish(best_shape, t, best_y, sq, uniform_score, best)
+}
+
+/// Each sample row's 16 subset sums (each adding its samples from the highest column
+/// down, the order the lanes keep) and the samples' summed squares.
+fn subset_sums(x: &[[f32; 3]; N]) -> ([[[f32; 3]; 16]; SY], f32) {
+    let mut sq = 0.0;
+    let rs = std::array::from_fn(|r| {
+        let px = &x[r * SX..r * SX + SX];
+        for p in px {
+            sq += dot(*p, *p);
+        }
+        std::array::from_fn(|s| {
+            let mut acc = [0.0; 3];
+            for (i, p) in px.iter().enumerate().rev() {
+                if s >> i & 1 == 1 {
+                    acc = add(acc, *p);
+                }
+            }
+            acc
+        })
+    });
+    (rs, sq)
 }
 
 /// A [`Fit`] from the winning shape's sums: `t` over the cell, `y` weighted by its ink,

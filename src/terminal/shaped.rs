@@ -69,33 +69,33 @@ fn palette_glyph(
 ) -> CellGlyph {
     let f = fit::fit_palette(rep, x, pal);
     let (on, off) = (pal.rgb[usize::from(f.on)], pal.rgb[usize::from(f.off)]);
-    let Some(sh) = f.shape else {
-        return CellGlyph {
-            error: f.error,
-            ..CellGlyph::uniform(on)
-        };
-    };
-    let (ch, pattern, fg, bg) = show_sides(sh, covered, on, off);
-    CellGlyph {
-        ch,
-        fg: Some(fg),
-        bg,
-        pattern,
-        error: f.error,
-    }
+    show_shape(f.shape, covered, on, off, f.error)
 }
 
-/// The glyph, its pattern and colours for shape `sh` in `on` over `off`: where no
+/// The cell showing shape `sh` (`None`: a space on `off`) in `on` over `off`: where no
 /// covered sample is bare the background is left to the terminal, and where none is
 /// inked the inverse glyph (if any) puts the terminal's background on that side.
-fn show_sides(sh: &fit::Shape, covered: u32, on: Rgb, off: Rgb) -> (char, u32, Rgb, Option<Rgb>) {
+fn show_shape(sh: Option<&fit::Shape>, covered: u32, on: Rgb, off: Rgb, error: f32) -> CellGlyph {
+    let Some(sh) = sh else {
+        return CellGlyph {
+            error,
+            ..CellGlyph::uniform(off)
+        };
+    };
     let (inked, bare) = (covered & sh.touched != 0, covered & sh.partial != 0);
-    if !bare {
+    let (ch, pattern, fg, bg) = if !bare {
         (sh.ch, sh.mask, on, None)
     } else if let (false, Some(inv)) = (inked, sh.inverse) {
         (inv, !sh.mask, off, None)
     } else {
         (sh.ch, sh.mask, on, Some(off))
+    };
+    CellGlyph {
+        ch,
+        fg: Some(fg),
+        bg,
+        pattern,
+        error,
     }
 }
 
@@ -292,24 +292,12 @@ fn glyph_of(
     palette: &Palette,
 ) -> CellGlyph {
     let srgb = |c: [f32; 3]| c.map(|v| space.decode(v));
-    let Some(sh) = f.shape else {
-        return CellGlyph {
-            error: f.error,
-            ..CellGlyph::uniform(srgb(f.on))
-        };
-    };
-    let (ch, pattern, fg, bg) = show_sides(sh, covered, srgb(f.on), srgb(f.off));
-    merge_if_same(
-        CellGlyph {
-            ch,
-            fg: Some(fg),
-            bg,
-            pattern,
-            error: f.error,
-        },
-        colors,
-        palette,
-    )
+    // A uniform fit's two colours are both the mean.
+    let g = show_shape(f.shape, covered, srgb(f.on), srgb(f.off), f.error);
+    if f.shape.is_none() {
+        return g;
+    }
+    merge_if_same(g, colors, palette)
 }
 
 #[cfg(test)]

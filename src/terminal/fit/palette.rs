@@ -18,7 +18,7 @@
 //! A glyph is drawn only where it removes a clear share of the best single entry's
 //! error ([`GLYPH_GAIN`]): see there for why.
 
-use super::{N, Repertoire, SX, SY, Shape};
+use super::{N, Repertoire, Shape};
 use crate::terminal::Palette;
 use crate::terminal::color::Rgb;
 
@@ -97,22 +97,7 @@ pub const GLYPH_GAIN: f32 = 0.3;
 /// error.
 #[must_use]
 pub fn fit_palette<'r>(rep: &'r Repertoire, x: &[[f32; 3]; N], pal: &FitPalette) -> PaletteFit<'r> {
-    let mut sq = 0.0;
-    let rs: [[[f32; 3]; 16]; SY] = std::array::from_fn(|r| {
-        let px = &x[r * SX..r * SX + SX];
-        for p in px {
-            sq += dot(*p, *p);
-        }
-        std::array::from_fn(|s| {
-            let mut acc = [0.0; 3];
-            for (i, p) in px.iter().enumerate() {
-                if s >> i & 1 == 1 {
-                    acc = [acc[0] + p[0], acc[1] + p[1], acc[2] + p[2]];
-                }
-            }
-            acc
-        })
-    });
+    let (rs, sq) = super::subset_sums(x);
     let t = rs.iter().fold([0.0f32; 3], |a, row| {
         [a[0] + row[15][0], a[1] + row[15][1], a[2] + row[15][2]]
     });

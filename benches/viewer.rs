@@ -1,6 +1,7 @@
 //! Whole viewer frames (`cargo bench --bench viewer`): transform, raster, glyph
-//! fitting, ratatui's diff, the perceptual cell cache and the write to a byte-counting sink, at 200×60 cells in
-//! braille and blocks modes, the model turning between frames as it does in the viewer.
+//! fitting, ratatui's diff, the perceptual cell cache and the write to a byte-counting
+//! sink, at 200×60 cells in braille, blocks, wedges and ascii modes, the model turning
+//! between frames as it does in the viewer.
 
 use std::cell::Cell;
 use std::io;
@@ -24,6 +25,7 @@ fn bench(c: &mut Criterion) {
             (GlyphMode::Blocks, ColorMode::Truecolor),
             (GlyphMode::Wedges, ColorMode::Truecolor),
             (GlyphMode::Wedges, ColorMode::Ansi256),
+            (GlyphMode::Wedges, ColorMode::Ansi16),
             (GlyphMode::Ascii, ColorMode::Truecolor),
         ] {
             let settings = ViewSettings {

@@ -5,6 +5,7 @@
 mod common;
 
 mod accuracy;
+mod bench_runs;
 mod bytes;
 mod cli_mistakes;
 mod cli_raster;

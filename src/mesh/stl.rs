@@ -109,13 +109,13 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
             // Each facet is 7 non-empty lines after the `solid` line.
             malformed(
                 nth_nonempty_line(bytes, 1 + 7 * k),
-                format!("facet {}: {problem}", k + 1),
+                format!("STL facet {}: {problem}", k + 1),
             )
         } else {
             malformed(
                 None,
                 format!(
-                    "triangle {} at byte {}: {problem}",
+                    "STL triangle {} at byte {}: {problem}",
                     k + 1,
                     HEADER + TRIANGLE * k
                 ),

@@ -1,4 +1,5 @@
-//! Triangle meshes: loading OBJ files, the built-in models, normalisation and normals.
+//! Triangle meshes: loading OBJ, STL and PLY files, the built-in models, normalisation
+//! and normals.
 //!
 //! Models are right-handed, y-up. [`Mesh::normalize`] centres a model on its bounding
 //! box and scales it so the largest |coordinate| is 1, which is what the standard
@@ -9,6 +10,12 @@ use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
+
+pub mod ply;
+pub mod read;
+pub mod stl;
+
+pub use read::MAX_MODEL_BYTES;
 
 /// The Utah teapot (Martin Newell, 1975; public domain), embedded so the viewer needs
 /// no files.
@@ -58,8 +65,18 @@ pub enum MeshError {
     Empty { path: PathBuf },
     #[error("{path}: not an OBJ file: {why}")]
     NotObj { path: PathBuf, why: String },
+    #[error("{path}: {what}, not a model file")]
+    NotRegular { path: PathBuf, what: &'static str },
+    #[error("{path}: {size} bytes is more than the {limit} bytes a model file may have")]
+    TooLarge {
+        path: PathBuf,
+        size: u64,
+        limit: u64,
+    },
+    #[error("{path}: {what} is not supported yet (convert it to OBJ, STL or PLY)")]
+    Unsupported { path: PathBuf, what: &'static str },
     #[error(
-        "unknown built-in model `{0}` (try `teapot`, `bunny`, `sphere:N` with N from 1 to 4194304, or an OBJ path)"
+        "unknown built-in model `{0}` (try `teapot`, `bunny`, `sphere:N` with N from 1 to 4194304, or an OBJ, STL or PLY path)"
     )]
     UnknownBuiltin(String),
 }
@@ -166,14 +183,24 @@ impl Mesh {
         Ok(m)
     }
 
-    /// Loads an OBJ file (triangulated, single index), unnormalised. A file that is
-    /// not text, or does not parse and starts like another format (see
+    /// Loads a model file, unnormalised: OBJ (triangulated, single index), STL or PLY,
+    /// told apart by content first and then by extension (see [`Format::detect`]).
+    /// Only a regular file of at most [`MAX_MODEL_BYTES`] is read. A file that is not
+    /// text, or does not parse as OBJ and starts like another format (see
     /// [`NOT_OBJ`]), is refused saying what it looks like.
     pub fn load(path: &Path) -> Result<Self, MeshError> {
-        let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-            path: path.into(),
-            source,
-        })?;
+        let bytes = read::read_regular(path, MAX_MODEL_BYTES)?;
+        match Format::detect(&bytes, path) {
+            Format::Stl => return stl::parse(&bytes, path),
+            Format::Ply => return ply::parse(&bytes, path),
+            Format::Gltf => {
+                return Err(MeshError::Unsupported {
+                    path: path.into(),
+                    what: "glTF",
+                });
+            }
+            Format::Obj => {}
+        }
         let not_obj = |why| MeshError::NotObj {
             path: path.into(),
             why,
@@ -276,10 +303,48 @@ pub const NOT_OBJ: &[(usize, &[u8], &str)] = &[
     (0, b"\xfd7zXZ\0", "an xz file"),
     (0, b"\x28\xb5\x2f\xfd", "a zstd file"),
     (0, b"\x7fELF", "an ELF executable"),
-    (0, b"glTF", "a binary glTF model (convert it to OBJ)"),
-    (0, b"ply", "a PLY model (convert it to OBJ)"),
-    (0, b"solid", "an STL model (convert it to OBJ)"),
+    (0, b"glTF", "a binary glTF model (not supported yet)"),
+    (0, b"ply", "a PLY model"),
+    (0, b"solid", "an STL model"),
 ];
+
+/// The model formats [`Mesh::load`] tells apart.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Obj,
+    Stl,
+    Ply,
+    /// Recognised to be refused clearly.
+    Gltf,
+}
+
+impl Format {
+    /// The format of a file: by content first (the `ply` magic line, `solid` then
+    /// `facet` for ASCII STL, 84 + 50·n bytes for binary STL, the `glTF` magic of
+    /// GLB), then by extension (`.stl`, `.ply`, `.gltf`, `.glb`), else OBJ.
+    #[must_use]
+    pub fn detect(bytes: &[u8], path: &Path) -> Self {
+        if ply::is_ply(bytes) {
+            return Self::Ply;
+        }
+        if bytes.starts_with(b"glTF") {
+            return Self::Gltf;
+        }
+        if stl::is_ascii_stl(bytes) || stl::is_binary_stl(bytes) {
+            return Self::Stl;
+        }
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("stl") => Self::Stl,
+            Some("ply") => Self::Ply,
+            Some("gltf" | "glb") => Self::Gltf,
+            _ => Self::Obj,
+        }
+    }
+}
 
 /// What a file that starts with `bytes` looks like, by [`NOT_OBJ`].
 #[must_use]
@@ -303,7 +368,14 @@ fn parse_obj(text: &str, path: &Path) -> Result<Mesh, MeshError> {
     let mtl_problem = std::cell::RefCell::new(None);
     let (models, materials) = tobj::load_obj_buf(&mut reader, &opts, |p| {
         let file = dir.join(p);
-        tobj::load_mtl(&file).inspect_err(|e| {
+        let bytes = match read::read_regular(&file, MAX_MODEL_BYTES) {
+            Ok(b) => b,
+            Err(e) => {
+                *mtl_problem.borrow_mut() = Some(e.to_string());
+                return Err(tobj::LoadError::OpenFileFailed);
+            }
+        };
+        tobj::load_mtl_buf(&mut bytes.as_slice()).inspect_err(|e| {
             *mtl_problem.borrow_mut() = Some(format!("{}: {e}", file.display()));
         })
     })

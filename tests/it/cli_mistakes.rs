@@ -82,7 +82,7 @@ fn a_file_or_model_that_resembles_a_subcommand_is_not_second_guessed() {
 }
 
 #[test]
-fn a_file_that_is_not_obj_says_what_it_looks_like() {
+fn a_file_that_is_not_a_model_says_what_it_looks_like() {
     let dir = scratch("not-obj");
     let png = b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0\0\x01";
     let cases: [(&str, &[u8], &str); 5] = [
@@ -104,7 +104,7 @@ fn a_file_that_is_not_obj_says_what_it_looks_like() {
         (
             "x.stl",
             b"solid cube\nfacet normal 0 0 1\nendfacet\nendsolid\n",
-            "an STL model",
+            "x.stl:2: STL facet 1:",
         ),
         (
             "x.bin",

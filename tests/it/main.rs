@@ -10,6 +10,7 @@ mod bytes;
 mod cli_mistakes;
 mod cli_raster;
 mod coverage;
+mod formats;
 mod framing;
 mod glyphs;
 mod hard_cases;

@@ -1,0 +1,73 @@
+//! Reading a model file: regular files only, and never more than a limit, so a FIFO,
+//! a device or a directory is refused at once instead of blocking or filling memory.
+
+use std::fs::File;
+use std::io::Read;
+use std::path::Path;
+
+use super::MeshError;
+
+/// The largest model (or material library) file read, in bytes: 2 GiB.
+pub const MAX_MODEL_BYTES: u64 = 2 << 30;
+
+/// Reads `path` whole if it is a regular file of at most `limit` bytes. The file's
+/// type is checked before it is opened (opening a FIFO blocks until a writer comes),
+/// and the read stops past `limit` even if the file grows meanwhile.
+pub fn read_regular(path: &Path, limit: u64) -> Result<Vec<u8>, MeshError> {
+    let io = |source| MeshError::Io {
+        path: path.into(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(MeshError::NotRegular {
+            path: path.into(),
+            what: file_kind(&meta),
+        });
+    }
+    let too_large = |size| MeshError::TooLarge {
+        path: path.into(),
+        size,
+        limit,
+    };
+    if meta.len() > limit {
+        return Err(too_large(meta.len()));
+    }
+    let file = File::open(path).map_err(io)?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|source| MeshError::Io {
+            path: path.into(),
+            source,
+        })?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// What a file that is not a regular file is, for the message.
+fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    let t = meta.file_type();
+    if t.is_dir() {
+        return "a directory";
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    "not a regular file"
+}

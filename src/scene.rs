@@ -166,7 +166,8 @@ impl From<(&MaterialFile, &Path)> for Material {
 #[derive(Clone, Debug)]
 pub struct SceneObject {
     pub desc: ObjectDesc,
-    pub mesh: Mesh,
+    /// Shared by the scene's clones (each viewer of `termrast serve` has one).
+    pub mesh: std::sync::Arc<Mesh>,
     /// Unique edges (wireframe and silhouettes), else empty.
     pub edges: Vec<[u32; 2]>,
     /// For each edge, the one or two triangles that share it (silhouettes), else empty.
@@ -556,7 +557,7 @@ fn load_object(
     };
     Ok(SceneObject {
         desc,
-        mesh,
+        mesh: std::sync::Arc::new(mesh),
         edges,
         edge_faces,
         face_centres,

@@ -20,6 +20,7 @@ pub mod inspector;
 pub mod link;
 pub mod pacing;
 pub mod panel;
+pub mod remote;
 pub mod status;
 pub mod viewport;
 
@@ -76,6 +77,9 @@ pub enum ViewError {
     Unsupported(String),
     #[error("the terminal went away (end of input)")]
     Gone,
+    /// No key or mouse input for this long (a remote viewer's idle limit).
+    #[error("idle for {0:?}")]
+    Idle(Duration),
     /// Ended by a signal: the process exits with 128 + its number.
     #[error("ended by signal {0}")]
     Signal(i32),
@@ -112,11 +116,14 @@ pub struct RunOptions {
 }
 
 /// What wakes the loop.
-enum Wake {
+#[derive(Debug)]
+pub enum Wake {
     Bytes(Vec<u8>),
     /// End of input, or an error reading it: the terminal is gone.
     Eof,
     Signal(i32),
+    /// A remote terminal's new size in cells (its own size is not ours to ask).
+    Resize(u16, u16),
 }
 
 /// Signals that end the viewer.
@@ -248,9 +255,15 @@ pub fn run(mut app: App, options: RunOptions) -> Result<(), ViewError> {
         &mut app,
         &mut terminal,
         options.fps.max(1),
-        (&wakes, &mut parser),
-        &mut pacer,
-        &bytes,
+        Ctx {
+            wakes: &wakes,
+            parser: &mut parser,
+            pacer: &mut pacer,
+            bytes: &bytes,
+            local: true,
+            gate: None,
+            idle: None,
+        },
     );
     LEAVING.store(RESTORING, Ordering::Release);
     // Leaving anyway: whatever arrives meanwhile changes nothing.
@@ -286,7 +299,7 @@ fn settle(
             Ok(Wake::Signal(sig)) if ENDING.contains(&sig) => {
                 return Some(ViewError::Signal(sig));
             }
-            Ok(Wake::Signal(_)) => {}
+            Ok(Wake::Signal(_) | Wake::Resize(..)) => {}
             Ok(Wake::Eof) | Err(mpsc::RecvTimeoutError::Disconnected) => {
                 return Some(ViewError::Gone);
             }
@@ -296,14 +309,30 @@ fn settle(
     None
 }
 
-type Term = Terminal<link::LinkBackend<Counting<Stdout>>>;
+type Term<W = Stdout> = Terminal<link::LinkBackend<Counting<W>>>;
+
+/// What the frame loop reads and counts, apart from the terminal it draws on.
+struct Ctx<'a> {
+    wakes: &'a mpsc::Receiver<Wake>,
+    parser: &'a mut Parser,
+    pacer: &'a mut Pacer,
+    bytes: &'a Cell<u64>,
+    /// The process's own terminal: Ctrl-Z and job-control signals suspend and resume
+    /// it. A remote terminal has no job control here.
+    local: bool,
+    /// Shared by the viewers of one process, so their frames take turns at the CPU.
+    gate: Option<&'a remote::RenderGate>,
+    /// Leave after this long without a key or mouse event.
+    idle: Option<Duration>,
+}
 
 /// Draws one frame and the pacing query after it.
-fn draw(
+fn draw<W: Write>(
     app: &mut App,
-    terminal: &mut Term,
+    terminal: &mut Term<W>,
     pacer: &mut Pacer,
     bytes: &Cell<u64>,
+    gate: Option<&remote::RenderGate>,
 ) -> io::Result<()> {
     let start_bytes = bytes.get();
     let size = terminal.size()?;
@@ -314,6 +343,7 @@ fn draw(
     let t0 = Instant::now();
     let mut render_time = Duration::ZERO;
     terminal.draw(|f| {
+        let _turn = gate.map(remote::RenderGate::enter);
         let r = Instant::now();
         app.draw(f);
         render_time = r.elapsed();
@@ -332,8 +362,8 @@ fn draw(
 /// Ctrl-Z: restores the terminal, stops, and on resuming takes it again. Answers to
 /// queries still on their way are waited for first, so they reach the viewer and not
 /// the shell that takes the terminal over.
-fn suspend(
-    terminal: &mut Term,
+fn suspend<W: Write>(
+    terminal: &mut Term<W>,
     (wakes, parser): (&mpsc::Receiver<Wake>, &mut Parser),
     pacer: &mut Pacer,
 ) -> Result<(), ViewError> {
@@ -345,22 +375,30 @@ fn suspend(
     Ok(resume(terminal, pacer)?)
 }
 
-fn resume(terminal: &mut Term, pacer: &mut Pacer) -> io::Result<()> {
+fn resume<W: Write>(terminal: &mut Term<W>, pacer: &mut Pacer) -> io::Result<()> {
     enter(terminal.backend_mut())?;
     pacer.reset();
     terminal.clear()
 }
 
-fn main_loop(
+fn main_loop<W: Write>(
     app: &mut App,
-    terminal: &mut Term,
+    terminal: &mut Term<W>,
     fps: u32,
-    (wakes, parser): (&mpsc::Receiver<Wake>, &mut Parser),
-    pacer: &mut Pacer,
-    bytes: &Cell<u64>,
+    ctx: Ctx<'_>,
 ) -> Result<(), ViewError> {
+    let Ctx {
+        wakes,
+        parser,
+        pacer,
+        bytes,
+        local,
+        gate,
+        idle,
+    } = ctx;
     let period = Duration::from_secs_f64(1.0 / f64::from(fps));
     let mut last = Instant::now();
+    let mut last_input = last;
     let mut next_frame = last;
     let mut dirty = true;
     // Resumed from our own suspension, before its SIGCONT arrived.
@@ -379,7 +417,7 @@ fn main_loop(
                 unpaced: pacer.unpaced && pacer.wants_query(),
                 budget: pacer.budget(now),
             };
-            draw(app, terminal, pacer, bytes)?;
+            draw(app, terminal, pacer, bytes, gate)?;
             app.frame_drawn(now);
             next_frame = now + period;
             dirty = false;
@@ -391,9 +429,14 @@ fn main_loop(
         last = now;
         // Sleep until the next frame is due (or what holds it, the pacer, may let it
         // go), a pending escape resolves, or input or a signal arrives.
+        let idle_at = idle.map(|d| last_input + d);
+        if idle_at.is_some_and(|t| now >= t) {
+            return Err(ViewError::Idle(idle.unwrap_or_default()));
+        }
         let wake_at = [
             wanted.then(|| next_frame.max(pacer.wake_at().unwrap_or(next_frame))),
             parser.deadline(),
+            idle_at,
         ]
         .into_iter()
         .flatten()
@@ -412,6 +455,11 @@ fn main_loop(
             Some(Wake::Signal(sig)) if ENDING.contains(&sig) => {
                 return Err(ViewError::Signal(sig));
             }
+            Some(Wake::Resize(cols, rows)) => {
+                terminal.backend_mut().set_size(cols, rows);
+                dirty = true;
+            }
+            Some(Wake::Signal(_)) if !local => {}
             Some(Wake::Signal(signal_hook::consts::SIGTSTP)) => {
                 suspend(terminal, (wakes, parser), pacer)?;
                 resumed = true;
@@ -431,12 +479,15 @@ fn main_loop(
             match input {
                 Input::DeviceAttributes => pacer.answered(now),
                 Input::PaletteColor(i, c) => dirty |= app.settings.terminal_color(i, c),
-                Input::Event(e) if e == ctrl_z => {
+                Input::Event(e) if local && e == ctrl_z => {
                     suspend(terminal, (wakes, parser), pacer)?;
                     resumed = true;
                     dirty = true;
                 }
-                Input::Event(e) => dirty |= app.handle(&e),
+                Input::Event(e) => {
+                    last_input = now;
+                    dirty |= app.handle(&e);
+                }
             }
         }
     }

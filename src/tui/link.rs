@@ -116,6 +116,12 @@ impl<W: Write> LinkBackend<W> {
         b
     }
 
+    /// Sets the size reported to ratatui (a remote terminal's window change); the next
+    /// draw clears and redraws the screen at that size.
+    pub fn set_size(&mut self, cols: u16, rows: u16) {
+        self.fixed = Some(Size::new(cols, rows));
+    }
+
     /// The writer.
     pub fn writer(&mut self) -> &mut W {
         &mut self.out

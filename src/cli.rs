@@ -48,6 +48,9 @@ pub enum Command {
     Line(line_cmd::LineArgs),
     /// Render frames as ANSI text to stdout (for pipes and scripts), or a PNG with --out.
     Render(render_cmd::PngArgs),
+    /// Serve the viewer over SSH: each watcher (`ssh -p 2222 HOST`) gets their own view
+    /// of one shared model or scene.
+    Serve(crate::serve::config::ServeArgs),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -74,6 +77,9 @@ pub enum BenchCommand {
     /// every changed cell, and what the cache costs the eye (SSIM through a terminal
     /// emulator), for every glyph mode and colour depth.
     Bytes(bytes_cmd::BytesArgs),
+    /// `termrast serve` under load: SSH watchers that read frames at a set rate and
+    /// answer the viewer's queries as a terminal does; frames/s each, server memory.
+    Serve(crate::serve::bench::BenchServeArgs),
 }
 
 /// Errors of the commands, each naming what it is about.
@@ -95,6 +101,8 @@ pub enum CliError {
     Fidelity(#[from] crate::fidelity::FidelityError),
     #[error(transparent)]
     Link(#[from] crate::slowlink::LinkError),
+    #[error(transparent)]
+    Serve(#[from] crate::serve::ServeError),
     #[error(transparent)]
     Io(#[from] io::Error),
     #[error("{0}")]
@@ -185,6 +193,10 @@ pub fn main() -> ExitCode {
         Some(Command::Bench(BenchCommand::Bytes(args))) => {
             bytes_cmd::run(&args, &mut io::stdout().lock())
         }
+        Some(Command::Bench(BenchCommand::Serve(args))) => {
+            crate::serve::bench::run(&args, &mut io::stdout().lock()).map_err(Into::into)
+        }
+        Some(Command::Serve(args)) => crate::serve::run(&args).map_err(Into::into),
         Some(Command::View(args)) => view_cmd::view(&args),
         None => view_cmd::view(&cli.view),
     };

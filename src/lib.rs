@@ -13,6 +13,7 @@ pub mod mesh;
 pub mod raster;
 pub mod render;
 pub mod scene;
+pub mod serve;
 pub mod simd;
 pub mod slowlink;
 pub mod terminal;

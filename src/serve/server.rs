@@ -258,6 +258,7 @@ impl Handler for Conn {
         reply: ChannelOpenHandle,
         _session: &mut Session,
     ) -> Result<(), Self::Error> {
+        lock(&self.log).end = Some("refused: port forwarding".into());
         reply
             .reject(ChannelOpenFailure::AdministrativelyProhibited)
             .await;
@@ -283,6 +284,7 @@ impl Handler for Conn {
         _: &mut u32,
         _: &mut Session,
     ) -> Result<bool, Self::Error> {
+        lock(&self.log).end = Some("refused: remote forwarding".into());
         Ok(false)
     }
 
@@ -561,15 +563,20 @@ async fn connection(
             grace.abort();
             if let Err(e) = r {
                 let mut l = lock(&log);
-                if l.end.is_none() {
-                    l.end = Some(format!("error: {e}"));
+                // A client that leaves without saying so is not an error of ours.
+                let eof = e.to_string().contains("eof");
+                if l.end.is_none() && !(eof && l.key.is_some()) {
+                    l.end = Some(if eof {
+                        "not authenticated".into()
+                    } else {
+                        format!("error: {e}")
+                    });
                 }
             }
         }
         Ok(Err(e)) => lock(&log).end = Some(format!("handshake: {e}")),
         Err(_) => lock(&log).end = Some("handshake timed out".into()),
     }
-    lock(&state.handles).remove(&id);
     lock(&state.watchers).remove(&id);
     // The watcher's own account of its end, once its channel is closed.
     if let Ok(Ok((end, bytes))) = tokio::time::timeout(Duration::from_secs(5), done_rx).await {
@@ -600,6 +607,8 @@ async fn connection(
         start.elapsed().as_secs_f64(),
         l.bytes,
     );
+    // Last: shutdown waits for this, so the line above is never lost.
+    lock(&state.handles).remove(&id);
 }
 
 /// `2026-12-03T10:52:35Z`.

@@ -20,6 +20,7 @@ mod mesh;
 mod model_frames;
 mod pipeline;
 mod scenes;
+mod serve;
 mod terminal;
 mod tmux;
 mod wire;

@@ -178,8 +178,10 @@ impl Watcher {
     /// the async threads.
     pub fn tell(&self, w: Wake) {
         let tx = self.wakes.clone();
-        if let Err(TrySendError::Full(w)) = tx.try_send(w) {
-            tokio::task::spawn_blocking(move || tx.send(w));
+        if let Err(TrySendError::Full(w)) = tx.try_send(w)
+            && let Ok(rt) = tokio::runtime::Handle::try_current()
+        {
+            rt.spawn_blocking(move || tx.send(w));
         }
     }
 

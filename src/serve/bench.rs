@@ -96,7 +96,11 @@ async fn watch(
     tally: Arc<std::sync::Mutex<Tally>>,
     stop: Arc<tokio::sync::Notify>,
 ) -> Result<(), russh::Error> {
-    let config = Arc::new(client::Config::default());
+    // As OpenSSH does for an interactive session: no Nagle delay on the answers.
+    let config = Arc::new(client::Config {
+        nodelay: true,
+        ..Default::default()
+    });
     let mut h = client::connect(config, ("127.0.0.1", port), Client).await?;
     h.authenticate_none("bench").await?;
     let mut ch = h.channel_open_session().await?;
@@ -158,6 +162,18 @@ fn rss_kb(pid: u32) -> u64 {
         .unwrap_or(0)
 }
 
+/// The server's CPU time so far (user + system), in seconds.
+fn cpu_s(pid: u32) -> f64 {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
+    // After the command name's closing parenthesis: state is field 3, utime 14, stime 15.
+    let rest = stat.rsplit_once(')').map_or("", |r| r.1);
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    // SAFETY: sysconf has no preconditions.
+    let hz = unsafe { libc::sysconf(libc::_SC_CLK_TCK) }.max(1) as f64;
+    (ticks(11) + ticks(12)) / hz
+}
+
 /// Starts `termrast serve` on a free loopback port; returns it and the port.
 fn start_server(args: &BenchServeArgs, dir: &std::path::Path) -> Result<(Child, u16), ServeError> {
     let n = (args.watchers + 2).to_string();
@@ -217,9 +233,9 @@ pub fn run(args: &BenchServeArgs, out: &mut impl Write) -> Result<(), ServeError
     let fast: Vec<_> = (0..args.watchers).map(|_| spawn(None)).collect();
     let measure = Duration::from_secs_f64(args.seconds.max(1.0));
     std::thread::sleep(Duration::from_secs(2));
-    let t0 = Instant::now();
+    let (t0, c0) = (Instant::now(), cpu_s(child.id()));
     std::thread::sleep(measure);
-    let t1 = Instant::now();
+    let (t1, c1) = (Instant::now(), cpu_s(child.id()));
     let rss1 = rss_kb(child.id());
     let fps = |from, to| -> Vec<f64> {
         fast.iter()
@@ -245,6 +261,11 @@ pub fn run(args: &BenchServeArgs, out: &mut impl Write) -> Result<(), ServeError
         out,
         "  {:.0} kB/s per watcher",
         bytes as f64 / 1e3 / t1.duration_since(t0).as_secs_f64() / args.watchers.max(1) as f64
+    )?;
+    writeln!(
+        out,
+        "  server CPU: {:.0} % of one core",
+        100.0 * (c1 - c0) / t1.duration_since(t0).as_secs_f64()
     )?;
     let per = rss1.saturating_sub(rss0) as f64 / args.watchers.max(1) as f64;
     writeln!(

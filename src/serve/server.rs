@@ -524,6 +524,9 @@ async fn connection(
             Some(why)
         }
     };
+    // Frames end in a small query: without this, Nagle holds it for the ACK of the
+    // frame, and every frame waits a delayed ACK (run_stream does not set it).
+    let _ = sock.set_nodelay(true);
     let id = state.next_id.fetch_add(1, Ordering::Relaxed);
     let log = Arc::new(Mutex::new(Log::default()));
     let authed = Arc::new(AtomicBool::new(false));

@@ -3,7 +3,8 @@
 //!
 //! - [`config`]: the arguments and who may watch;
 //! - [`keys`]: the host key (made once, kept private) and the admitted keys;
-//! - [`server`]: connections, limits, authentication, refusals, the log, shutdown;
+//! - [`server`]: connections, limits, the log, shutdown; `conn.rs`: authentication
+//!   and refusals (russh's handler);
 //! - [`session`]: a watcher's viewer on its own thread, bounded both ways;
 //! - [`bench`]: the load generator (`termrast bench serve`).
 //!
@@ -11,6 +12,7 @@
 
 pub mod bench;
 pub mod config;
+mod conn;
 pub mod keys;
 pub mod server;
 pub mod session;

@@ -12,7 +12,9 @@ Security: every watcher gets the viewer and nothing else. Commands (ssh host CMD
 subsystems (sftp), port, agent and X11 forwarding are refused; a session without a
 terminal is told so and closed. Nothing a client sends runs a program, opens a file
 or reaches the network. Who may watch: the keys in --authorized-keys (OpenSSH
-format), or anyone with --public; listening beyond loopback requires one of them.
+format), or anyone with --public; listening beyond loopback requires one of them
+(on loopback, neither means ~/.ssh/authorized_keys). Limits: --max-clients,
+--max-per-address, 6 authentication attempts in 30 s, --idle-timeout.
 The host key (Ed25519) is made on first start, kept with mode 0600 (refused if
 others can read it); check its fingerprint, printed at start, on first connect.";
 

@@ -1,11 +1,7 @@
 //! The SSH side: accepting connections within the limits, authentication, what a
 //! session may ask for, one log line per connection, and shutting down.
 //!
-//! Each connection gets a [`Conn`], russh's handler: it admits keys (or anyone, when
-//! public), keeps what the pty and environment requests say, and starts the viewer
-//! on the shell request. Everything else a client may ask (commands, subsystems,
-//! forwarding of ports, agent or X11, a second session) is refused, so nothing it
-//! sends runs a program, opens a file or opens a connection.
+//! Each connection gets a [`super::conn::Conn`], russh's handler.
 
 use std::collections::HashMap;
 use std::net::{IpAddr, SocketAddr};
@@ -14,13 +10,14 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime};
 
 use russh::keys::PrivateKey;
-use russh::server::{Auth, ChannelOpenHandle, Handle, Handler, Msg, Session};
-use russh::{Channel, ChannelId, ChannelOpenFailure, ChannelWriteHalf, Disconnect, MethodKind};
+use russh::server::Handle;
+use russh::{Disconnect, MethodKind};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::oneshot;
 
-use super::keys::{Authorized, fingerprint};
-use super::session::{self, Outcome, Request, Shared, Watcher};
+use super::conn::{Conn, Log};
+use super::keys::Authorized;
+use super::session::{Request, Shared};
 
 /// Time from connecting to being authenticated (as sshd's LoginGraceTime).
 pub const LOGIN_GRACE: Duration = Duration::from_secs(30);
@@ -48,7 +45,7 @@ pub struct State {
     open: Mutex<HashMap<IpAddr, usize>>,
     refusing: Mutex<usize>,
     /// Running watchers, to end them on shutdown; and every connection's handle.
-    watchers: Mutex<HashMap<u64, std::sync::mpsc::SyncSender<crate::tui::Wake>>>,
+    pub(super) watchers: Mutex<HashMap<u64, std::sync::mpsc::SyncSender<crate::tui::Wake>>>,
     handles: Mutex<HashMap<u64, Handle>>,
     next_id: AtomicU64,
 }
@@ -104,7 +101,7 @@ impl State {
     }
 }
 
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+pub(super) fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
@@ -129,333 +126,6 @@ pub fn russh_config(key: PrivateKey, public: bool) -> russh::server::Config {
         keepalive_max: 4,
         nodelay: true,
         ..Default::default()
-    }
-}
-
-/// What a connection's log line says.
-#[derive(Debug, Default)]
-struct Log {
-    key: Option<String>,
-    size: Option<(u16, u16)>,
-    bytes: u64,
-    end: Option<String>,
-}
-
-/// A connection: russh's handler.
-struct Conn {
-    id: u64,
-    state: Arc<State>,
-    /// Refused for this reason (too many watchers): told in the banner, never admitted.
-    refuse: Option<String>,
-    log: Arc<Mutex<Log>>,
-    authed: Arc<AtomicBool>,
-    channel: Option<ChannelId>,
-    write: Option<ChannelWriteHalf<Msg>>,
-    req: Request,
-    watcher: Option<Watcher>,
-    done: Option<oneshot::Sender<Outcome>>,
-}
-
-impl Conn {
-    fn ours(&self, channel: ChannelId) -> bool {
-        self.channel == Some(channel)
-    }
-
-    fn accept(&mut self, key: String) -> Auth {
-        lock(&self.log).key = Some(key);
-        self.authed.store(true, Ordering::Release);
-        Auth::Accept
-    }
-}
-
-impl Drop for Conn {
-    fn drop(&mut self) {
-        if let Some(w) = &self.watcher {
-            w.tell(crate::tui::Wake::Eof);
-        }
-    }
-}
-
-impl Handler for Conn {
-    type Error = russh::Error;
-
-    async fn authentication_banner(&mut self) -> Result<Option<String>, Self::Error> {
-        Ok(self.refuse.as_ref().map(|r| format!("termrast: {r}\r\n")))
-    }
-
-    async fn auth_none(&mut self, _user: &str) -> Result<Auth, Self::Error> {
-        if self.refuse.is_none() && matches!(self.state.admit, Admit::Public) {
-            return Ok(self.accept("public".into()));
-        }
-        Ok(Auth::reject())
-    }
-
-    async fn auth_publickey_offered(
-        &mut self,
-        _user: &str,
-        offer: russh::server::PublicKeyOffer<'_>,
-    ) -> Result<Auth, Self::Error> {
-        Ok(match &self.state.admit {
-            Admit::Keys(a) if self.refuse.is_none() && a.admits(offer.public_key) => Auth::Accept,
-            _ => Auth::reject(),
-        })
-    }
-
-    async fn auth_publickey(
-        &mut self,
-        _user: &str,
-        key: russh::server::VerifiedPublicKey<'_>,
-    ) -> Result<Auth, Self::Error> {
-        Ok(match &self.state.admit {
-            Admit::Keys(a) if self.refuse.is_none() && a.admits(key.public_key) => {
-                self.accept(fingerprint(key.public_key))
-            }
-            _ => Auth::reject(),
-        })
-    }
-
-    async fn channel_open_session(
-        &mut self,
-        channel: Channel<Msg>,
-        reply: ChannelOpenHandle,
-        _session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        if self.channel.is_some() {
-            reply
-                .reject(ChannelOpenFailure::AdministrativelyProhibited)
-                .await;
-            return Ok(());
-        }
-        self.channel = Some(channel.id());
-        // Requests and data come through this handler; the read half is not read.
-        let (_read, write) = channel.split();
-        self.write = Some(write);
-        reply.accept().await;
-        Ok(())
-    }
-
-    async fn channel_open_x11(
-        &mut self,
-        _channel: Channel<Msg>,
-        _address: &str,
-        _port: u32,
-        reply: ChannelOpenHandle,
-        _session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        reply
-            .reject(ChannelOpenFailure::AdministrativelyProhibited)
-            .await;
-        Ok(())
-    }
-
-    async fn channel_open_direct_tcpip(
-        &mut self,
-        _channel: Channel<Msg>,
-        _host: &str,
-        _port: u32,
-        _from: &str,
-        _from_port: u32,
-        reply: ChannelOpenHandle,
-        _session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        lock(&self.log).end = Some("refused: port forwarding".into());
-        reply
-            .reject(ChannelOpenFailure::AdministrativelyProhibited)
-            .await;
-        Ok(())
-    }
-
-    async fn channel_open_direct_streamlocal(
-        &mut self,
-        _channel: Channel<Msg>,
-        _path: &str,
-        reply: ChannelOpenHandle,
-        _session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        reply
-            .reject(ChannelOpenFailure::AdministrativelyProhibited)
-            .await;
-        Ok(())
-    }
-
-    async fn tcpip_forward(
-        &mut self,
-        _: &str,
-        _: &mut u32,
-        _: &mut Session,
-    ) -> Result<bool, Self::Error> {
-        lock(&self.log).end = Some("refused: remote forwarding".into());
-        Ok(false)
-    }
-
-    async fn streamlocal_forward(&mut self, _: &str, _: &mut Session) -> Result<bool, Self::Error> {
-        Ok(false)
-    }
-
-    async fn agent_request(&mut self, _: ChannelId, _: &mut Session) -> Result<bool, Self::Error> {
-        Ok(false)
-    }
-
-    async fn x11_request(
-        &mut self,
-        channel: ChannelId,
-        _: bool,
-        _: &str,
-        _: &str,
-        _: u32,
-        session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        session.channel_failure(channel)
-    }
-
-    async fn pty_request(
-        &mut self,
-        channel: ChannelId,
-        term: &str,
-        cols: u32,
-        rows: u32,
-        _pix_width: u32,
-        _pix_height: u32,
-        _modes: &[(russh::Pty, u32)],
-        session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        if !self.ours(channel) || self.watcher.is_some() || term.len() > 64 {
-            return session.channel_failure(channel);
-        }
-        let (c, r) = session::clamp_size(cols, rows);
-        self.req.pty = Some((term.to_string(), c, r));
-        lock(&self.log).size = Some((c, r));
-        session.channel_success(channel)
-    }
-
-    async fn env_request(
-        &mut self,
-        channel: ChannelId,
-        name: &str,
-        value: &str,
-        session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        if self.ours(channel) && self.watcher.is_none() && self.req.set_env(name, value) {
-            session.channel_success(channel)
-        } else {
-            session.channel_failure(channel)
-        }
-    }
-
-    async fn shell_request(
-        &mut self,
-        channel: ChannelId,
-        session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        let Some(write) = self.write.take().filter(|_| self.ours(channel)) else {
-            return session.channel_failure(channel);
-        };
-        if self.req.pty.is_none() {
-            session.channel_success(channel)?;
-            lock(&self.log).end = Some("refused: no pty".into());
-            let text = "termrast: this server shows a 3D viewer and needs a terminal; \
-                        connect with `ssh -t`\r\n";
-            session.data(channel, text.as_bytes().to_vec())?;
-            session.exit_status_request(channel, 1)?;
-            session.eof(channel)?;
-            return session.close(channel);
-        }
-        let done = self.done.take().expect("one shell per connection");
-        match session::start(
-            &self.state.shared,
-            &self.req,
-            write,
-            session.handle(),
-            channel,
-            done,
-        ) {
-            Ok(w) => {
-                lock(&self.state.watchers).insert(self.id, w.sender());
-                self.watcher = Some(w);
-                session.channel_success(channel)
-            }
-            Err(e) => {
-                lock(&self.log).end = Some(format!("error: {e}"));
-                session.channel_failure(channel)?;
-                session.close(channel)
-            }
-        }
-    }
-
-    async fn exec_request(
-        &mut self,
-        channel: ChannelId,
-        _: &[u8],
-        session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        lock(&self.log).end = Some("refused: exec".into());
-        session.channel_failure(channel)?;
-        session.close(channel)
-    }
-
-    async fn subsystem_request(
-        &mut self,
-        channel: ChannelId,
-        name: &str,
-        session: &mut Session,
-    ) -> Result<(), Self::Error> {
-        lock(&self.log).end = Some(format!("refused: subsystem {}", name.escape_debug()));
-        session.channel_failure(channel)?;
-        session.close(channel)
-    }
-
-    async fn window_change_request(
-        &mut self,
-        channel: ChannelId,
-        cols: u32,
-        rows: u32,
-        _: u32,
-        _: u32,
-        _: &mut Session,
-    ) -> Result<(), Self::Error> {
-        let (c, r) = session::clamp_size(cols, rows);
-        if self.ours(channel) {
-            lock(&self.log).size = Some((c, r));
-            if let Some(w) = &self.watcher {
-                w.tell(crate::tui::Wake::Resize(c, r));
-            }
-        }
-        Ok(())
-    }
-
-    async fn data(
-        &mut self,
-        channel: ChannelId,
-        data: &[u8],
-        _: &mut Session,
-    ) -> Result<(), Self::Error> {
-        if self.ours(channel)
-            && let Some(w) = &mut self.watcher
-        {
-            w.input(data);
-        }
-        Ok(())
-    }
-
-    async fn channel_eof(
-        &mut self,
-        channel: ChannelId,
-        _: &mut Session,
-    ) -> Result<(), Self::Error> {
-        if self.ours(channel)
-            && let Some(w) = &self.watcher
-        {
-            w.tell(crate::tui::Wake::Eof);
-        }
-        Ok(())
-    }
-
-    async fn channel_close(
-        &mut self,
-        channel: ChannelId,
-        s: &mut Session,
-    ) -> Result<(), Self::Error> {
-        self.channel_eof(channel, s).await
     }
 }
 

@@ -543,6 +543,32 @@ fn faults_stall_only_their_own_client() {
     assert!(t.moving("w"), "the watcher stopped during the flood");
     let _ = stuck.kill();
     let _ = stuck.wait();
+    // Random bytes as another client's keyboard (through ssh, escapes and all): the
+    // watcher and the server do not notice.
+    // Once the killed, the flood and the stuck client are gone (a line each).
+    assert!(
+        until(|| server.log().matches(" end=").count() >= 8),
+        "{}",
+        server.log()
+    );
+    t.open("r", 70, 20, &server.ssh(Some(&key), "-t -e none"));
+    t.watching("r");
+    let mut x: u32 = 0x2545_f491;
+    for _ in 0..8 {
+        let bytes: Vec<String> = (0..64)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                format!("{:02x}", x & 0xff)
+            })
+            .collect();
+        let mut args = vec!["send-keys", "-t", "r", "-H"];
+        args.extend(bytes.iter().map(String::as_str));
+        t.tmux(&args);
+    }
+    assert!(server.alive(), "random input ended the server");
+    assert!(t.moving("w"), "the watcher stopped during random input");
     t.keys("w", "q");
     assert!(t.wait("w", |s| s.contains("EXIT=")).contains("EXIT=0"));
 }

@@ -301,8 +301,11 @@ impl Handler for Conn {
         let (c, r) = session::clamp_size(cols, rows);
         if self.ours(channel) {
             lock(&self.log).size = Some((c, r));
-            if let Some(w) = &self.watcher {
-                w.tell(crate::tui::Wake::Resize(c, r));
+            match (&self.watcher, &mut self.req.pty) {
+                (Some(w), _) => w.tell(crate::tui::Wake::Resize(c, r)),
+                // Before the shell: the viewer starts at this size.
+                (None, Some(pty)) => (pty.1, pty.2) = (c, r),
+                (None, None) => {}
             }
         }
         Ok(())

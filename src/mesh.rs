@@ -1,4 +1,4 @@
-//! Triangle meshes: loading OBJ, STL and PLY files, the built-in models, normalisation
+//! Triangle meshes: loading OBJ, STL, PLY and glTF files, the built-in models, normalisation
 //! and normals.
 //!
 //! Models are right-handed, y-up. [`Mesh::normalize`] centres a model on its bounding
@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
+pub mod gltf;
 pub mod material;
 mod mtl;
 mod obj;
@@ -83,10 +84,10 @@ pub enum MeshError {
         size: u64,
         limit: u64,
     },
-    #[error("{path}: {what} is not supported yet (convert it to OBJ, STL or PLY)")]
+    #[error("{path}: {what} is not supported (convert it to OBJ, STL, PLY or glTF)")]
     Unsupported { path: PathBuf, what: &'static str },
     #[error(
-        "unknown built-in model `{0}` (try `teapot`, `bunny`, `sphere:N` with N from 1 to 4194304, or an OBJ, STL or PLY path)"
+        "unknown built-in model `{0}` (try `teapot`, `bunny`, `sphere:N` with N from 1 to 4194304, or an OBJ, STL, PLY or glTF path)"
     )]
     UnknownBuiltin(String),
 }
@@ -181,8 +182,9 @@ impl Mesh {
         Ok(m)
     }
 
-    /// Loads a model file, unnormalised: OBJ (triangulated, single index), STL or PLY,
-    /// told apart by content first and then by extension (see [`Format::detect`]).
+    /// Loads a model file, unnormalised: OBJ (triangulated, single index), STL, PLY or
+    /// glTF (`.gltf`, `.glb`), told apart by content first and then by extension (see
+    /// [`Format::detect`]).
     /// Only a regular file of at most [`MAX_MODEL_BYTES`] is read. A file that is not
     /// text, or does not parse as OBJ and starts like another format (see
     /// [`NOT_OBJ`]), is refused saying what it looks like.
@@ -191,12 +193,7 @@ impl Mesh {
         match Format::detect(&bytes, path) {
             Format::Stl => return stl::parse(&bytes, path),
             Format::Ply => return ply::parse(&bytes, path),
-            Format::Gltf => {
-                return Err(MeshError::Unsupported {
-                    path: path.into(),
-                    what: "glTF",
-                });
-            }
+            Format::Gltf => return gltf::parse(&bytes, path),
             Format::Obj => {}
         }
         obj::parse(&bytes, path).map_err(|e| match (&e, sniff(&bytes)) {
@@ -299,7 +296,7 @@ pub const NOT_OBJ: &[(usize, &[u8], &str)] = &[
     (0, b"\xfd7zXZ\0", "an xz file"),
     (0, b"\x28\xb5\x2f\xfd", "a zstd file"),
     (0, b"\x7fELF", "an ELF executable"),
-    (0, b"glTF", "a binary glTF model (not supported yet)"),
+    (0, b"glTF", "a binary glTF model"),
     (0, b"ply", "a PLY model"),
     (0, b"solid", "an STL model"),
 ];
@@ -310,20 +307,21 @@ pub enum Format {
     Obj,
     Stl,
     Ply,
-    /// Recognised to be refused clearly.
+    /// `.gltf` (JSON) or `.glb` (binary).
     Gltf,
 }
 
 impl Format {
     /// The format of a file: by content first (the `ply` magic line, `solid` then
     /// `facet` for ASCII STL, 84 + 50·n bytes for binary STL, the `glTF` magic of
-    /// GLB), then by extension (`.stl`, `.ply`, `.gltf`, `.glb`), else OBJ.
+    /// GLB, a JSON object with an `"asset"` key for `.gltf`), then by extension
+    /// (`.stl`, `.ply`, `.gltf`, `.glb`), else OBJ.
     #[must_use]
     pub fn detect(bytes: &[u8], path: &Path) -> Self {
         if ply::is_ply(bytes) {
             return Self::Ply;
         }
-        if bytes.starts_with(b"glTF") {
+        if gltf::is_glb(bytes) || gltf::is_gltf_json(bytes) {
             return Self::Gltf;
         }
         if stl::is_ascii_stl(bytes) || stl::is_binary_stl(bytes) {

@@ -12,6 +12,7 @@ mod cli_raster;
 mod coverage;
 mod formats;
 mod framing;
+mod gltf;
 mod glyphs;
 mod hard_cases;
 mod lines;

@@ -147,6 +147,19 @@ fn load(bytes: &[u8], path: &Path) -> Result<Mesh, Failure> {
 /// The document's own checks (references in range, required fields), by JSON path.
 /// `min`/`max` are not used here, so a file that lacks them still loads.
 fn validate(root: &gltf::json::Root) -> Result<(), String> {
+    // The crate's own check indexes the POSITION accessor unchecked: check it first.
+    for (i, mesh) in root.meshes.iter().enumerate() {
+        for (j, prim) in mesh.primitives.iter().enumerate() {
+            let position = gltf::json::validation::Checked::Valid(Semantic::Positions);
+            if let Some(a) = prim.attributes.get(&position)
+                && a.value() >= root.accessors.len()
+            {
+                return Err(format!(
+                    "meshes[{i}].primitives[{j}].attributes.POSITION: index out of bounds"
+                ));
+            }
+        }
+    }
     let mut first: Option<String> = None;
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         let p = path().to_string();

@@ -315,10 +315,10 @@ impl Builder<'_> {
                 t.swap(1, 2);
             }
         }
-        let material = match prim.material().index() {
-            Some(i) => Some(self.material(prim.material(), i)),
-            None => None,
-        };
+        let material = prim
+            .material()
+            .index()
+            .map(|i| self.material(prim.material(), i));
         let uv_set = material.map_or(0, |(_, set)| set);
         let normals = attr(Semantic::Normals, "NORMAL", &[3])?;
         let uvs = attr(

@@ -55,9 +55,7 @@ struct Doc {
 impl Doc {
     /// Appends `bytes` as a buffer view; its index.
     fn view(&mut self, bytes: &[u8]) -> usize {
-        while self.bin.len() % 4 != 0 {
-            self.bin.push(0);
-        }
+        self.bin.resize(self.bin.len().next_multiple_of(4), 0);
         self.views.push(format!(
             r#"{{"buffer":0,"byteOffset":{},"byteLength":{}}}"#,
             self.bin.len(),
@@ -121,13 +119,9 @@ impl Doc {
     /// The document as a GLB: header, JSON chunk, BIN chunk.
     fn glb(&self, rest: &str) -> Vec<u8> {
         let mut json = self.json(None, rest).into_bytes();
-        while json.len() % 4 != 0 {
-            json.push(b' ');
-        }
+        json.resize(json.len().next_multiple_of(4), b' ');
         let mut bin = self.bin.clone();
-        while bin.len() % 4 != 0 {
-            bin.push(0);
-        }
+        bin.resize(bin.len().next_multiple_of(4), 0);
         let mut out = b"glTF".to_vec();
         out.extend(2u32.to_le_bytes());
         out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());

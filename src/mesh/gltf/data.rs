@@ -22,6 +22,8 @@ use crate::mesh::read::{MAX_MODEL_BYTES, read_regular};
 /// expand to.
 const MAX_ZERO_FILLED: usize = 1 << 28;
 
+type Chunk<'a> = (&'a [u8], &'a [u8]);
+
 /// Splits a GLB file into its JSON chunk and its BIN chunk, if any.
 pub fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), String> {
     let u32_at = |at: usize| {
@@ -43,7 +45,8 @@ pub fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<&[u8]>), String> {
         ));
     }
     let bytes = &bytes[..length.max(12)];
-    let chunk = |at: usize| -> Result<Option<(&[u8], &[u8])>, String> {
+    // A chunk's type and data, or none at the end of the file.
+    let chunk = |at: usize| -> Result<Option<Chunk>, String> {
         if at >= bytes.len() {
             return Ok(None);
         }

@@ -370,13 +370,13 @@ mod tests {
     #[test]
     fn glb_chunks_are_checked() {
         let mut glb = b"glTF\x02\0\0\0".to_vec();
-        glb.extend(28u32.to_le_bytes());
+        glb.extend(24u32.to_le_bytes());
         glb.extend(4u32.to_le_bytes());
         glb.extend(b"JSON{}  ");
         assert_eq!(split_glb(&glb).unwrap(), (&b"{}  "[..], None));
         glb[8] = 200;
         assert!(split_glb(&glb).unwrap_err().contains("200 bytes"));
-        glb[8] = 28;
+        glb[8] = 24;
         glb[12] = 9;
         assert!(split_glb(&glb).unwrap_err().contains("byte 12"));
         assert!(split_glb(b"glTF\x01").is_err());

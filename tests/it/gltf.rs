@@ -10,10 +10,14 @@ use glam::{Vec2, Vec3};
 use proptest::prelude::*;
 use termrast::mesh::{Format, Mesh, MeshError, NO_MATERIAL, TextureSource, gltf};
 
-fn temp(name: &str, bytes: &[u8]) -> PathBuf {
+fn temp_path(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("termrast-gltf-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
+    dir.join(name)
+}
+
+fn temp(name: &str, bytes: &[u8]) -> PathBuf {
+    let path = temp_path(name);
     std::fs::write(&path, bytes).unwrap();
     path
 }
@@ -375,10 +379,7 @@ fn base_colour_textures_embedded_and_beside_the_file() {
     };
     assert_eq!(colour(tex[0].as_ref().unwrap()), Vec3::X);
     assert_eq!(colour(tex[1].as_ref().unwrap()), Vec3::Y);
-    assert_eq!(
-        tex[2],
-        Some(TextureSource::File(temp("blue tex.png", &png([0, 0, 255]))))
-    );
+    assert_eq!(tex[2], Some(TextureSource::File(temp_path("blue tex.png"))));
     assert_eq!(tex[3], None);
     assert!(
         m.warnings
@@ -395,32 +396,70 @@ fn base_colour_textures_embedded_and_beside_the_file() {
     );
 }
 
-#[test]
-fn the_cube_as_gltf_covers_what_the_cube_as_obj_does() {
+/// A frame of the model's default scene (its materials, lit): depth bits and colours.
+fn frame(path: &Path) -> (Vec<u32>, Vec<[u8; 4]>) {
     use termrast::raster::Target;
     use termrast::scene::Scene;
     use termrast::scene::render::{SceneFrame, SceneView};
-    let (d, rest) = cube_doc();
-    let depth = |path: &Path| {
-        let scene = Scene::for_model(path.to_str().unwrap()).unwrap();
-        let mut frame = SceneFrame::new(&scene);
-        let view = SceneView {
-            time: 0.0,
-            yaw: 0.6,
-            pitch: 0.4,
-            zoom: 1.0,
-            pixel_aspect: 1.0,
-        };
-        frame.draw(&scene, Target::new(64, 48), &view);
-        let bits: Vec<u32> = frame
-            .renderer
-            .depth
-            .to_vec()
-            .iter()
-            .map(|d| d.to_bits())
-            .collect();
-        (bits, frame.color.0)
+    let scene = Scene::for_model(path.to_str().unwrap()).unwrap();
+    let mut frame = SceneFrame::new(&scene);
+    let view = SceneView {
+        time: 0.0,
+        yaw: 0.6,
+        pitch: 0.4,
+        zoom: 1.0,
+        pixel_aspect: 1.0,
     };
+    frame.draw(&scene, Target::new(64, 48), &view);
+    let bits: Vec<u32> = frame
+        .renderer
+        .depth
+        .to_vec()
+        .iter()
+        .map(|d| d.to_bits())
+        .collect();
+    (bits, frame.color.0)
+}
+
+#[test]
+fn an_embedded_texture_and_vertex_colours_show_in_the_frame() {
+    let mut d = Doc::default();
+    let p = d.positions(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let n = d.accessor(&f32_bytes([0.0, 0.0, 1.0].repeat(3)), 5126, "VEC3", 3, "");
+    let uv = d.accessor(&f32_bytes([0.0; 6]), 5126, "VEC2", 3, "");
+    let view = d.view(&png([0, 255, 0]));
+    let green = |c: &[u8; 4]| c[1] > 40 && c[0] < c[1] / 4 && c[2] < c[1] / 4;
+    let rest = format!(
+        r#"{},"materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0}}}}}}],
+        "textures":[{{"source":0}}],"images":[{{"bufferView":{view},"mimeType":"image/png"}}]"#,
+        one_node(
+            &format!(
+                r#"{{"attributes":{{"POSITION":{p},"NORMAL":{n},"TEXCOORD_0":{uv}}},"material":0}}"#
+            ),
+            ""
+        )
+    );
+    let (_, colour) = frame(&temp("green.glb", &d.glb(&rest)));
+    assert!(
+        colour.iter().filter(|c| green(c)).count() > 50,
+        "the texture is drawn"
+    );
+    let c = d.accessor(&f32_bytes([0.0, 1.0, 0.0].repeat(3)), 5126, "VEC3", 3, "");
+    let rest = one_node(
+        &format!(r#"{{"attributes":{{"POSITION":{p},"NORMAL":{n},"COLOR_0":{c}}}}}"#),
+        "",
+    );
+    let (_, colour) = frame(&temp("green-vertices.glb", &d.glb(&rest)));
+    assert!(
+        colour.iter().filter(|c| green(c)).count() > 50,
+        "the colours are drawn"
+    );
+}
+
+#[test]
+fn the_cube_as_gltf_covers_what_the_cube_as_obj_does() {
+    let (d, rest) = cube_doc();
+    let depth = frame;
     let (obj_depth, obj_colour) = depth(&temp("cube.obj", cube_obj().as_bytes()));
     let (glb_depth, glb_colour) = depth(&temp("render-cube.glb", &d.glb(&rest)));
     assert!(
@@ -499,7 +538,7 @@ fn errors_name_the_file_and_the_json_path() {
     bad.bin[n - 2..].copy_from_slice(&9u16.to_le_bytes());
     let e = load_err("badindex.glb", &bad.glb(&rest));
     assert!(
-        e.starts_with(&format!("{}: ", temp("badindex.glb", b"").display())),
+        e.starts_with(&format!("{}: ", temp_path("badindex.glb").display())),
         "{e}"
     );
     assert!(

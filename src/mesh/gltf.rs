@@ -28,6 +28,10 @@ mod data;
 
 use data::Buffers;
 
+/// Most vertices, and most triangles, the nodes of a model may add up to (the
+/// triangle limit of a scene).
+const MAX_INSTANCED: usize = 1 << 25;
+
 /// Whether `bytes` start with the GLB magic.
 #[must_use]
 pub fn is_glb(bytes: &[u8]) -> bool {
@@ -342,8 +346,14 @@ impl Builder<'_> {
         }
         let o = &mut self.out;
         let base = o.positions.len();
-        if base + n > u32::MAX as usize {
-            return Err(format!("{at}: more than {} vertices in all", u32::MAX).into());
+        // Nodes may draw one mesh many times: bound what the instances add up to
+        // before allocating it.
+        if base + n > MAX_INSTANCED || o.indices.len() / 3 + tris.len() > MAX_INSTANCED {
+            return Err(format!(
+                "nodes[{node}]: with {at}, the scene's nodes draw more than {MAX_INSTANCED} \
+                 vertices or triangles, more than are read"
+            )
+            .into());
         }
         o.missing_normals |= normals.is_none();
         o.any_uv |= uvs.is_some();

@@ -77,7 +77,10 @@ pub enum MeshError {
     NotObj { path: PathBuf, why: String },
     #[error("{path}: {what}, not a model file")]
     NotRegular { path: PathBuf, what: &'static str },
-    #[error("{path}: {size} bytes is more than the {limit} bytes a model file may have")]
+    #[error(
+        "{path}: {size} bytes is more than the {limit} bytes a model file may have (set {} to allow more)",
+        read::LIMIT_VAR
+    )]
     TooLarge {
         path: PathBuf,
         size: u64,
@@ -187,7 +190,7 @@ impl Mesh {
     /// text, or does not parse as OBJ and starts like another format (see
     /// [`NOT_OBJ`]), is refused saying what it looks like.
     pub fn load(path: &Path) -> Result<Self, MeshError> {
-        let bytes = read::read_regular(path, MAX_MODEL_BYTES)?;
+        let bytes = read::read_regular(path, read::model_limit())?;
         match Format::detect(&bytes, path) {
             Format::Stl => return stl::parse(&bytes, path),
             Format::Ply => return ply::parse(&bytes, path),

@@ -288,6 +288,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
         )));
     }
     let mut scene = Scene::standard(&args.scene.model)?;
+    super::view_cmd::print_warnings(&scene.warnings, &mut std::io::stderr().lock());
     scene.set_mode(args.scene.mode);
     scene.set_cull(args.scene.cull);
     let target = args.size;

@@ -164,7 +164,8 @@ impl Mesh {
         m
     }
 
-    /// A model by name: `teapot`, `bunny`, `sphere:N`, or a path to an OBJ file.
+    /// A model by name: `teapot`, `bunny`, `sphere:N`, or a path to a model file,
+    /// normalised.
     pub fn from_spec(spec: &str) -> Result<Self, MeshError> {
         match spec {
             "teapot" => return Ok(Self::teapot()),

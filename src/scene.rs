@@ -20,7 +20,8 @@
 //! [object.material]        # color, lighting = "none" | "flat" | "gouraud" |
 //!                          # "lambert" | "blinn-phong", specular, shininess,
 //!                          # vertex_colors, texture = "off" | "nearest" | "bilinear",
-//!                          # image (a PNG instead of the OBJ material's map_Kd)
+//!                          # image (a PNG instead of the OBJ material's map_Kd),
+//!                          # from_model (the model file's materials, too)
 //! [object.effects]         # depth_test, cull, fog = { start, end, color },
 //!                          # depth_shading, wireframe, silhouette
 //! ```
@@ -40,6 +41,7 @@
 
 pub mod file;
 mod load;
+pub use load::MAX_SCENE_TRIANGLES;
 pub mod plan;
 pub mod render;
 pub mod texture;

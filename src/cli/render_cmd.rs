@@ -23,8 +23,8 @@ pub const RADIANS_PER_FRAME: f32 = 0.05;
 /// Options shared by the 3D commands.
 #[derive(Debug, Args)]
 pub struct SceneArgs {
-    /// `teapot` or `bunny` (built in), `sphere:N` (UV sphere of about N triangles), an
-    /// OBJ path, or (for `render`) a scene file `SCENE.toml`.
+    /// `teapot` or `bunny` (built in), `sphere:N` (UV sphere of about N triangles), a
+    /// model file (OBJ, STL, PLY), or (for `render`) a scene file `SCENE.toml`.
     #[arg(default_value = "teapot")]
     pub model: String,
     /// Skip back faces (a model; a scene file's effects say).
@@ -282,7 +282,7 @@ impl std::fmt::Display for BenchReport {
 pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliError> {
     if is_scene_path(&args.scene.model) {
         return Err(super::CliError::Usage(format!(
-            "{0}: bench render times a model (`teapot`, `bunny`, `sphere:N` or an OBJ file), \
+            "{0}: bench render times a model (`teapot`, `bunny`, `sphere:N` or a model file), \
              not a scene file; `termrast render {0}` draws the scene",
             args.scene.model
         )));

@@ -94,8 +94,8 @@ impl LookArgs {
 /// Arguments of the viewer.
 #[derive(Debug, Args, Clone)]
 pub struct ViewArgs {
-    /// `teapot` or `bunny` (built in), `sphere:N`, an OBJ path, or a scene file
-    /// `SCENE.toml`.
+    /// `teapot` or `bunny` (built in), `sphere:N`, a model file (OBJ, STL, PLY), or a
+    /// scene file `SCENE.toml`.
     #[arg(default_value = "teapot")]
     pub model: String,
     #[command(flatten)]

@@ -75,7 +75,7 @@ pub enum MeshError {
     Empty { path: PathBuf, note: String },
     #[error("{path}: not an OBJ file: {why}")]
     NotObj { path: PathBuf, why: String },
-    #[error("{path}: {what}, not a model file")]
+    #[error("{path}: {what}, not a regular file")]
     NotRegular { path: PathBuf, what: &'static str },
     #[error(
         "{path}: {size} bytes is more than the {limit} bytes a model file may have (set {} to allow more)",

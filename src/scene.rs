@@ -350,9 +350,18 @@ impl Scene {
 
     /// Reads and loads a scene file.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        // Only a regular file, and not without end: a FIFO or a device would hang.
+        let bytes = crate::mesh::read::read_regular(path, 16 << 20).map_err(|e| match e {
+            MeshError::Io { path, source } => SceneError::Io { path, source },
+            e => SceneError::Mesh(e),
+        })?;
+        let text = String::from_utf8(bytes).map_err(|e| SceneError::Invalid {
             path: path.into(),
-            source,
+            line: None,
+            problem: format!(
+                "not text (byte {} is not UTF-8)",
+                e.utf8_error().valid_up_to()
+            ),
         })?;
         Self::from_text(&text, path)
     }

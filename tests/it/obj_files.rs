@@ -457,3 +457,24 @@ fn errors_still_name_the_line() {
         assert!(e.to_string().contains(line), "{e}");
     }
 }
+
+#[test]
+fn a_scene_file_that_is_not_a_regular_file_is_refused_at_once() {
+    let d = dir("scene-fifo");
+    let fifo = d.join("s.toml");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(
+        made.is_ok_and(|s| s.success()),
+        "mkfifo is available on the test machines"
+    );
+    let (tx, rx) = std::sync::mpsc::channel();
+    let p = fifo.clone();
+    std::thread::spawn(move || tx.send(Scene::load(&p).map(|_| ()).map_err(|e| e.to_string())));
+    let e = rx
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("refused at once, not blocked")
+        .unwrap_err();
+    assert!(e.contains("s.toml") && e.contains("FIFO"), "{e}");
+    let e = Scene::load(&d).map(|_| ()).unwrap_err().to_string();
+    assert!(e.contains("a directory"), "{e}");
+}

@@ -8,6 +8,7 @@ pub mod effects_cmd;
 pub mod fidelity_cmd;
 pub mod line_cmd;
 pub mod link_cmd;
+pub mod load_cmd;
 pub mod raster_cmd;
 pub mod render_cmd;
 pub mod suggest;
@@ -74,6 +75,9 @@ pub enum BenchCommand {
     /// every changed cell, and what the cache costs the eye (SSIM through a terminal
     /// emulator), for every glyph mode and colour depth.
     Bytes(bytes_cmd::BytesArgs),
+    /// Load time and peak memory of a large model (a sphere of 1M triangles) in every
+    /// format, each loaded by a child process of its own.
+    Load(load_cmd::LoadArgs),
 }
 
 /// Errors of the commands, each naming what it is about.
@@ -97,6 +101,11 @@ pub enum CliError {
     Link(#[from] crate::slowlink::LinkError),
     #[error(transparent)]
     Io(#[from] io::Error),
+    #[error("{}: {source}", path.display())]
+    File {
+        path: std::path::PathBuf,
+        source: io::Error,
+    },
     #[error("{0}")]
     Usage(String),
 }
@@ -184,6 +193,9 @@ pub fn main() -> ExitCode {
         }
         Some(Command::Bench(BenchCommand::Bytes(args))) => {
             bytes_cmd::run(&args, &mut io::stdout().lock())
+        }
+        Some(Command::Bench(BenchCommand::Load(args))) => {
+            load_cmd::run(&args, &mut io::stdout().lock())
         }
         Some(Command::View(args)) => view_cmd::view(&args),
         None => view_cmd::view(&cli.view),

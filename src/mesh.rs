@@ -76,9 +76,12 @@ pub enum MeshError {
     Empty { path: PathBuf, note: String },
     #[error("{path}: not an OBJ file: {why}")]
     NotObj { path: PathBuf, why: String },
-    #[error("{path}: {what}, not a model file")]
+    #[error("{path}: {what}, not a regular file")]
     NotRegular { path: PathBuf, what: &'static str },
-    #[error("{path}: {size} bytes is more than the {limit} bytes a model file may have")]
+    #[error(
+        "{path}: {size} bytes is more than the {limit} bytes a model file may have (set {} to allow more)",
+        read::LIMIT_VAR
+    )]
     TooLarge {
         path: PathBuf,
         size: u64,
@@ -162,7 +165,8 @@ impl Mesh {
         m
     }
 
-    /// A model by name: `teapot`, `bunny`, `sphere:N`, or a path to an OBJ file.
+    /// A model by name: `teapot`, `bunny`, `sphere:N`, or a path to a model file,
+    /// normalised.
     pub fn from_spec(spec: &str) -> Result<Self, MeshError> {
         match spec {
             "teapot" => return Ok(Self::teapot()),
@@ -189,7 +193,7 @@ impl Mesh {
     /// text, or does not parse as OBJ and starts like another format (see
     /// [`NOT_OBJ`]), is refused saying what it looks like.
     pub fn load(path: &Path) -> Result<Self, MeshError> {
-        let bytes = read::read_regular(path, MAX_MODEL_BYTES)?;
+        let bytes = read::read_regular(path, read::model_limit())?;
         match Format::detect(&bytes, path) {
             Format::Stl => return stl::parse(&bytes, path),
             Format::Ply => return ply::parse(&bytes, path),

@@ -20,7 +20,8 @@
 //! [object.material]        # color, lighting = "none" | "flat" | "gouraud" |
 //!                          # "lambert" | "blinn-phong", specular, shininess,
 //!                          # vertex_colors, texture = "off" | "nearest" | "bilinear",
-//!                          # image (a PNG instead of the OBJ material's map_Kd)
+//!                          # image (a PNG instead of the OBJ material's map_Kd),
+//!                          # from_model (the model file's materials, too)
 //! [object.effects]         # depth_test, cull, fog = { start, end, color },
 //!                          # depth_shading, wireframe, silhouette
 //! ```
@@ -40,6 +41,7 @@
 
 pub mod file;
 mod load;
+pub use load::MAX_SCENE_TRIANGLES;
 pub mod plan;
 pub mod render;
 pub mod texture;
@@ -348,9 +350,18 @@ impl Scene {
 
     /// Reads and loads a scene file.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        // Only a regular file, and not without end: a FIFO or a device would hang.
+        let bytes = crate::mesh::read::read_regular(path, 16 << 20).map_err(|e| match e {
+            MeshError::Io { path, source } => SceneError::Io { path, source },
+            e => SceneError::Mesh(e),
+        })?;
+        let text = String::from_utf8(bytes).map_err(|e| SceneError::Invalid {
             path: path.into(),
-            source,
+            line: None,
+            problem: format!(
+                "not text (byte {} is not UTF-8)",
+                e.utf8_error().valid_up_to()
+            ),
         })?;
         Self::from_text(&text, path)
     }

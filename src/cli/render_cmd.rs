@@ -23,8 +23,8 @@ pub const RADIANS_PER_FRAME: f32 = 0.05;
 /// Options shared by the 3D commands.
 #[derive(Debug, Args)]
 pub struct SceneArgs {
-    /// `teapot` or `bunny` (built in), `sphere:N` (UV sphere of about N triangles), an
-    /// OBJ, STL, PLY or glTF path, or (for `render`) a scene file `SCENE.toml`.
+    /// `teapot` or `bunny` (built in), `sphere:N` (UV sphere of about N triangles), a
+    /// model file (OBJ, STL, PLY, glTF), or (for `render`) a scene file `SCENE.toml`.
     #[arg(default_value = "teapot")]
     pub model: String,
     /// Skip back faces (a model; a scene file's effects say).
@@ -288,6 +288,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
         )));
     }
     let mut scene = Scene::standard(&args.scene.model)?;
+    super::view_cmd::print_warnings(&scene.warnings, &mut std::io::stderr().lock());
     scene.set_mode(args.scene.mode);
     scene.set_cull(args.scene.cull);
     let target = args.size;

@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 
 use super::material::{MeshMaterial, NO_MATERIAL, Warnings};
 use super::text::{self, number, words};
-use super::{MAX_MODEL_BYTES, Mesh, MeshError, mtl, read};
+use super::{Mesh, MeshError, mtl, read};
 
 /// No index (a face corner without `vt` or `vn`).
 const NONE: u32 = u32::MAX;
@@ -285,7 +285,7 @@ impl Obj {
                 continue;
             }
             self.libraries.push(file.clone());
-            match read::read_regular(&file, MAX_MODEL_BYTES) {
+            match read::read_regular(&file, read::model_limit()) {
                 Ok(bytes) => {
                     let mats = mtl::parse(&bytes, &file, w);
                     self.materials.extend(mats);
@@ -319,12 +319,12 @@ impl Obj {
             }
         }
         let at = |line: usize| format!("{}:{line}", path.display());
-        for (count, what) in [
-            (self.polylines, "polyline (`l`)"),
-            (self.points, "point (`p`)"),
+        for (kind, count, what) in [
+            ("not-drawn-l", self.polylines, "polyline (`l`)"),
+            ("not-drawn-p", self.points, "point (`p`)"),
         ] {
             if count.0 > 0 {
-                w.add("not-drawn", || {
+                w.add(kind, || {
                     format!(
                         "{}: {} {what} element{} not drawn: only faces are",
                         at(count.1),
@@ -446,5 +446,24 @@ impl Obj {
         }
         m.warnings = w.into_lines();
         Ok(m)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_library_is_read_once_however_often_it_is_named() {
+        let dir = std::env::temp_dir().join(format!("termrast-obj-unit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("a.mtl"), "newmtl a\nKd 1 0 0\n").unwrap();
+        let mut o = Obj::default();
+        let mut w = Warnings::default();
+        for _ in 0..100 {
+            o.library(b"mtllib a.mtl a.mtl", &dir, "x.obj:1", &mut w);
+        }
+        assert_eq!((o.libraries.len(), o.materials.len()), (1, 1));
+        assert!(w.into_lines().is_empty());
     }
 }

@@ -19,6 +19,7 @@ mod lines;
 mod link;
 mod mesh;
 mod model_frames;
+mod obj_files;
 mod pipeline;
 mod scenes;
 mod terminal;

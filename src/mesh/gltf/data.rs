@@ -5,7 +5,7 @@
 //! Buffer URIs: `data:` (base64, or percent-encoded) is decoded; a relative path is
 //! resolved against the model's folder, and an absolute path or one with `..` is read
 //! too (the user could name that file directly), but only as a regular file through
-//! [`read_regular`], with all buffer files together limited to [`MAX_MODEL_BYTES`].
+//! [`read_regular`], with all buffer files together within [`model_limit`].
 //! Any other scheme (`http:`, `file:`) is refused: the loader never uses the network.
 
 use std::borrow::Cow;
@@ -16,7 +16,7 @@ use base64::Engine;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::{Accessor, Document, buffer};
 
-use crate::mesh::read::{MAX_MODEL_BYTES, read_regular};
+use crate::mesh::read::{model_limit, read_regular};
 
 /// Most bytes an accessor without a buffer view (all zeros, then sparse values) may
 /// expand to.
@@ -174,7 +174,7 @@ impl<'a> Buffers<'a> {
                 }
                 None => {
                     let path = uri_path(&self.dir, uri);
-                    let limit = MAX_MODEL_BYTES.saturating_sub(self.read_from_files.get());
+                    let limit = model_limit().saturating_sub(self.read_from_files.get());
                     let bytes = read_regular(&path, limit).map_err(|e| format!("{at}: {e}"))?;
                     self.read_from_files
                         .set(self.read_from_files.get() + bytes.len() as u64);

@@ -4,7 +4,7 @@
 //! # The file
 //!
 //! The minimal scene is one `[[object]]` with `model = "teapot"` (or `bunny`,
-//! `sphere:N`, or an OBJ path relative to the scene file). Every other key has a
+//! `sphere:N`, or a model file relative to the scene file). Every other key has a
 //! default and every effect is off: such a scene is the model's silhouette in flat
 //! white, drawn in order without a depth buffer. See `examples/scenes/` for the rest:
 //!
@@ -245,7 +245,7 @@ pub fn is_scene_path(spec: &str) -> bool {
 }
 
 impl Scene {
-    /// The default scene of a model (what an OBJ path is shorthand for): the model
+    /// The default scene of a model (what a model path is shorthand for): the model
     /// with depth test and per-pixel Lambert under the standard lights, its bounding
     /// sphere framed, turning on a turntable, as the viewer and `render` show it.
     pub fn for_model(spec: &str) -> Result<Self, SceneError> {

@@ -33,6 +33,7 @@ const FILES: &[(&str, &str)] = &[
     ("STL ASCII", "sphere-ascii.stl"),
     ("PLY binary", "sphere.ply"),
     ("PLY ASCII", "sphere-ascii.ply"),
+    ("GLB", "sphere.glb"),
 ];
 
 /// Writes the files, loads each in a child and prints a table.
@@ -208,7 +209,47 @@ fn write_as(m: &Mesh, format: &str, path: &Path) -> io::Result<()> {
                 }
             }
         }
+        "GLB" => write_glb(m, &mut w)?,
         _ => unreachable!("the formats of FILES"),
     }
     w.flush()
+}
+
+/// A binary glTF: one buffer of f32 positions and u32 indices, one mesh, one node.
+fn write_glb(m: &Mesh, w: &mut impl Write) -> io::Result<()> {
+    let mut bin: Vec<u8> = Vec::with_capacity(m.positions.len() * 12 + m.indices.len() * 4);
+    let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+    for v in &m.positions {
+        for (i, c) in v.to_array().into_iter().enumerate() {
+            lo[i] = lo[i].min(c);
+            hi[i] = hi[i].max(c);
+            bin.extend(c.to_le_bytes());
+        }
+    }
+    let positions = bin.len();
+    bin.extend(m.indices.iter().flat_map(|i| i.to_le_bytes()));
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],"buffers":[{{"byteLength":{}}}],"bufferViews":[{{"buffer":0,"byteLength":{positions}}},{{"buffer":0,"byteOffset":{positions},"byteLength":{}}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":{},"type":"VEC3","min":{lo:?},"max":{hi:?}}},{{"bufferView":1,"componentType":5125,"count":{},"type":"SCALAR"}}]}}"#,
+        bin.len(),
+        bin.len() - positions,
+        m.positions.len(),
+        m.indices.len()
+    );
+    let mut json = json.into_bytes();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    w.write_all(b"glTF")?;
+    w.write_all(&2u32.to_le_bytes())?;
+    w.write_all(&(total as u32).to_le_bytes())?;
+    w.write_all(&(json.len() as u32).to_le_bytes())?;
+    w.write_all(b"JSON")?;
+    w.write_all(&json)?;
+    w.write_all(&(bin.len() as u32).to_le_bytes())?;
+    w.write_all(b"BIN\0")?;
+    w.write_all(&bin)
 }

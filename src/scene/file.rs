@@ -149,7 +149,7 @@ pub enum TextureMode {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectFile {
-    /// `teapot`, `bunny`, `sphere:N`, or an OBJ path relative to the scene file.
+    /// `teapot`, `bunny`, `sphere:N`, or a model file relative to the scene file.
     pub model: String,
     #[serde(default)]
     pub position: [f32; 3],

@@ -8,6 +8,7 @@ pub mod effects_cmd;
 pub mod fidelity_cmd;
 pub mod line_cmd;
 pub mod link_cmd;
+pub mod load_cmd;
 pub mod raster_cmd;
 pub mod render_cmd;
 pub mod suggest;
@@ -80,6 +81,9 @@ pub enum BenchCommand {
     /// `termrast serve` under load: SSH watchers that read frames at a set rate and
     /// answer the viewer's queries as a terminal does; frames/s each, server memory.
     Serve(crate::serve::bench::BenchServeArgs),
+    /// Load time and peak memory of a large model (a sphere of 1M triangles) in every
+    /// format, each loaded by a child process of its own.
+    Load(load_cmd::LoadArgs),
 }
 
 /// Errors of the commands, each naming what it is about.
@@ -105,6 +109,11 @@ pub enum CliError {
     Serve(#[from] crate::serve::ServeError),
     #[error(transparent)]
     Io(#[from] io::Error),
+    #[error("{}: {source}", path.display())]
+    File {
+        path: std::path::PathBuf,
+        source: io::Error,
+    },
     #[error("{0}")]
     Usage(String),
 }
@@ -197,6 +206,9 @@ pub fn main() -> ExitCode {
             crate::serve::bench::run(&args, &mut io::stdout().lock()).map_err(Into::into)
         }
         Some(Command::Serve(args)) => crate::serve::run(&args).map_err(Into::into),
+        Some(Command::Bench(BenchCommand::Load(args))) => {
+            load_cmd::run(&args, &mut io::stdout().lock())
+        }
         Some(Command::View(args)) => view_cmd::view(&args),
         None => view_cmd::view(&cli.view),
     };

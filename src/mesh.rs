@@ -1,4 +1,4 @@
-//! Triangle meshes: loading OBJ, STL and PLY files, the built-in models, normalisation
+//! Triangle meshes: loading OBJ, STL, PLY and glTF files, the built-in models, normalisation
 //! and normals.
 //!
 //! Models are right-handed, y-up. [`Mesh::normalize`] centres a model on its bounding
@@ -6,14 +6,20 @@
 //! camera (distance 2.6, 45° field of view) expects.
 
 use std::fmt;
-use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
+pub mod gltf;
+pub mod material;
+mod mtl;
+mod obj;
 pub mod ply;
 pub mod read;
 pub mod stl;
+mod text;
+
+pub use material::{MeshMaterial, NO_MATERIAL, TextureSource};
 
 pub use read::MAX_MODEL_BYTES;
 
@@ -29,7 +35,7 @@ const BUNNY_OBJ: &str = include_str!("mesh/bunny.obj");
 pub const MAX_SPHERE_TRIANGLES: usize = 1 << 22;
 
 /// An indexed triangle mesh. Optional attributes are empty when absent.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     /// Where the mesh came from, for messages and the status line.
     pub name: String,
@@ -42,9 +48,14 @@ pub struct Mesh {
     pub colors: Vec<Vec3>,
     /// Three indices per triangle.
     pub indices: Vec<u32>,
-    /// The diffuse texture (`map_Kd`) of the first material that has one, resolved
-    /// relative to the OBJ file, or why the material library could not be read.
-    pub texture: Result<Option<PathBuf>, String>,
+    /// The materials the file declares, or empty.
+    pub materials: Vec<MeshMaterial>,
+    /// Per triangle, its index in `materials` (or [`NO_MATERIAL`]); empty when the
+    /// file has no materials.
+    pub triangle_materials: Vec<u32>,
+    /// What the loader went past (a bad material line, a missing texture), each
+    /// naming the file and line, for the user to see.
+    pub warnings: Vec<String>,
 }
 
 /// Why a mesh could not be loaded.
@@ -61,38 +72,27 @@ pub enum MeshError {
         line: Option<usize>,
         problem: String,
     },
-    #[error("{path}: no triangles")]
-    Empty { path: PathBuf },
+    #[error("{path}: no triangles{note}")]
+    Empty { path: PathBuf, note: String },
     #[error("{path}: not an OBJ file: {why}")]
     NotObj { path: PathBuf, why: String },
-    #[error("{path}: {what}, not a model file")]
+    #[error("{path}: {what}, not a regular file")]
     NotRegular { path: PathBuf, what: &'static str },
-    #[error("{path}: {size} bytes is more than the {limit} bytes a model file may have")]
+    #[error(
+        "{path}: {size} bytes is more than the {limit} bytes a model file may have (set {} to allow more)",
+        read::LIMIT_VAR
+    )]
     TooLarge {
         path: PathBuf,
         size: u64,
         limit: u64,
     },
-    #[error("{path}: {what} is not supported yet (convert it to OBJ, STL or PLY)")]
+    #[error("{path}: {what} is not supported (convert it to OBJ, STL, PLY or glTF)")]
     Unsupported { path: PathBuf, what: &'static str },
     #[error(
-        "unknown built-in model `{0}` (try `teapot`, `bunny`, `sphere:N` with N from 1 to 4194304, or an OBJ, STL or PLY path)"
+        "unknown built-in model `{0}` (try `teapot`, `bunny`, `sphere:N` with N from 1 to 4194304, or an OBJ, STL, PLY or glTF path)"
     )]
     UnknownBuiltin(String),
-}
-
-impl Default for Mesh {
-    fn default() -> Self {
-        Self {
-            name: String::new(),
-            positions: Vec::new(),
-            normals: Vec::new(),
-            uvs: Vec::new(),
-            colors: Vec::new(),
-            indices: Vec::new(),
-            texture: Ok(None),
-        }
-    }
 }
 
 impl Mesh {
@@ -105,7 +105,8 @@ impl Mesh {
     /// The built-in Utah teapot, normalised, without normals.
     #[must_use]
     pub fn teapot() -> Self {
-        let mut m = parse_obj(TEAPOT_OBJ, Path::new("teapot")).expect("embedded teapot parses");
+        let mut m =
+            obj::parse(TEAPOT_OBJ.as_bytes(), Path::new("teapot")).expect("embedded teapot parses");
         m.name = "teapot".into();
         m.normalize();
         m
@@ -114,7 +115,8 @@ impl Mesh {
     /// The built-in Stanford bunny, normalised, without normals.
     #[must_use]
     pub fn bunny() -> Self {
-        let mut m = parse_obj(BUNNY_OBJ, Path::new("bunny")).expect("embedded bunny parses");
+        let mut m =
+            obj::parse(BUNNY_OBJ.as_bytes(), Path::new("bunny")).expect("embedded bunny parses");
         m.name = "bunny".into();
         m.normalize();
         m
@@ -163,7 +165,8 @@ impl Mesh {
         m
     }
 
-    /// A model by name: `teapot`, `bunny`, `sphere:N`, or a path to an OBJ file.
+    /// A model by name: `teapot`, `bunny`, `sphere:N`, or a path to a model file,
+    /// normalised.
     pub fn from_spec(spec: &str) -> Result<Self, MeshError> {
         match spec {
             "teapot" => return Ok(Self::teapot()),
@@ -183,48 +186,42 @@ impl Mesh {
         Ok(m)
     }
 
-    /// Loads a model file, unnormalised: OBJ (triangulated, single index), STL or PLY,
-    /// told apart by content first and then by extension (see [`Format::detect`]).
+    /// Loads a model file, unnormalised: OBJ (triangulated, single index), STL, PLY or
+    /// glTF (`.gltf`, `.glb`), told apart by content first and then by extension (see
+    /// [`Format::detect`]).
     /// Only a regular file of at most [`MAX_MODEL_BYTES`] is read. A file that is not
     /// text, or does not parse as OBJ and starts like another format (see
     /// [`NOT_OBJ`]), is refused saying what it looks like.
     pub fn load(path: &Path) -> Result<Self, MeshError> {
-        let bytes = read::read_regular(path, MAX_MODEL_BYTES)?;
+        let bytes = read::read_regular(path, read::model_limit())?;
         match Format::detect(&bytes, path) {
             Format::Stl => return stl::parse(&bytes, path),
             Format::Ply => return ply::parse(&bytes, path),
-            Format::Gltf => {
-                return Err(MeshError::Unsupported {
-                    path: path.into(),
-                    what: "glTF",
-                });
-            }
+            Format::Gltf => return gltf::parse(&bytes, path),
             Format::Obj => {}
         }
-        let not_obj = |why| MeshError::NotObj {
-            path: path.into(),
-            why,
-        };
-        let looks_like = |bytes: &[u8]| sniff(bytes).map(|what| format!("it looks like {what}"));
-        let text = String::from_utf8(bytes).map_err(|e| {
-            not_obj(looks_like(e.as_bytes()).unwrap_or_else(|| {
-                format!(
-                    "it is not text (byte {} is not UTF-8)",
-                    e.utf8_error().valid_up_to()
-                )
-            }))
-        })?;
-        let mut m =
-            parse_obj(&text, path).map_err(|e| looks_like(text.as_bytes()).map_or(e, not_obj))?;
-        m.name = path.display().to_string();
-        Ok(m)
+        obj::parse(&bytes, path).map_err(|e| match (&e, sniff(&bytes)) {
+            (
+                MeshError::Malformed { .. } | MeshError::Empty { .. } | MeshError::NotObj { .. },
+                Some(what),
+            ) => MeshError::NotObj {
+                path: path.into(),
+                why: format!("it looks like {what}"),
+            },
+            _ => e,
+        })
     }
 
-    /// Centres the mesh on its bounding box and scales it so max |coordinate| = 1.
+    /// Centres the mesh on its bounding box and scales it so max |coordinate| = 1,
+    /// in f64 so that neither the centre of a huge model nor the scale of a tiny one
+    /// overflows.
     pub fn normalize(&mut self) {
         let (lo, hi) = self.positions.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+            (
+                glam::DVec3::splat(f64::INFINITY),
+                glam::DVec3::splat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.min(p.as_dvec3()), hi.max(p.as_dvec3())),
         );
         let centre = (lo + hi) * 0.5;
         let extent = (hi - centre).max_element();
@@ -234,7 +231,7 @@ impl Mesh {
             1.0
         };
         for p in &mut self.positions {
-            *p = (*p - centre) * scale;
+            *p = ((p.as_dvec3() - centre) * scale).as_vec3();
         }
     }
 
@@ -303,7 +300,7 @@ pub const NOT_OBJ: &[(usize, &[u8], &str)] = &[
     (0, b"\xfd7zXZ\0", "an xz file"),
     (0, b"\x28\xb5\x2f\xfd", "a zstd file"),
     (0, b"\x7fELF", "an ELF executable"),
-    (0, b"glTF", "a binary glTF model (not supported yet)"),
+    (0, b"glTF", "a binary glTF model"),
     (0, b"ply", "a PLY model"),
     (0, b"solid", "an STL model"),
 ];
@@ -314,20 +311,21 @@ pub enum Format {
     Obj,
     Stl,
     Ply,
-    /// Recognised to be refused clearly.
+    /// `.gltf` (JSON) or `.glb` (binary).
     Gltf,
 }
 
 impl Format {
     /// The format of a file: by content first (the `ply` magic line, `solid` then
     /// `facet` for ASCII STL, 84 + 50·n bytes for binary STL, the `glTF` magic of
-    /// GLB), then by extension (`.stl`, `.ply`, `.gltf`, `.glb`), else OBJ.
+    /// GLB, a JSON object with an `"asset"` key for `.gltf`), then by extension
+    /// (`.stl`, `.ply`, `.gltf`, `.glb`), else OBJ.
     #[must_use]
     pub fn detect(bytes: &[u8], path: &Path) -> Self {
         if ply::is_ply(bytes) {
             return Self::Ply;
         }
-        if bytes.starts_with(b"glTF") {
+        if gltf::is_glb(bytes) || gltf::is_gltf_json(bytes) {
             return Self::Gltf;
         }
         if stl::is_ascii_stl(bytes) || stl::is_binary_stl(bytes) {
@@ -355,155 +353,16 @@ pub fn sniff(bytes: &[u8]) -> Option<&'static str> {
         .map(|(_, _, what)| *what)
 }
 
-/// Parses OBJ text with tobj and merges its models into one mesh.
-fn parse_obj(text: &str, path: &Path) -> Result<Mesh, MeshError> {
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ..Default::default()
-    };
-    let mut reader = BufReader::new(text.as_bytes());
-    // Material libraries are read relative to the OBJ file (embedded models have none).
-    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let mtl_problem = std::cell::RefCell::new(None);
-    let (models, materials) = tobj::load_obj_buf(&mut reader, &opts, |p| {
-        let file = dir.join(p);
-        let bytes = match read::read_regular(&file, MAX_MODEL_BYTES) {
-            Ok(b) => b,
-            Err(e) => {
-                *mtl_problem.borrow_mut() = Some(e.to_string());
-                return Err(tobj::LoadError::OpenFileFailed);
-            }
-        };
-        tobj::load_mtl_buf(&mut bytes.as_slice()).inspect_err(|e| {
-            *mtl_problem.borrow_mut() = Some(format!("{}: {e}", file.display()));
-        })
-    })
-    .map_err(|e| {
-        let (line, problem) = locate_error(text, e);
-        MeshError::Malformed {
-            path: path.into(),
-            line,
-            problem,
-        }
-    })?;
-    let mut m = Mesh {
-        texture: match (mtl_problem.into_inner(), materials) {
-            (Some(p), _) => Err(p),
-            (None, Err(e)) => Err(format!("material library: {e}")),
-            (None, Ok(mats)) => Ok(mats
-                .iter()
-                .find_map(|mt| mt.diffuse_texture.as_deref())
-                .map(|t| dir.join(t.trim()))),
-        },
-        ..Mesh::default()
-    };
-    for model in models {
-        let mm = model.mesh;
-        let base = m.positions.len() as u32;
-        let count = mm.positions.len() / 3;
-        m.positions.extend(
-            mm.positions
-                .chunks_exact(3)
-                .map(|p| Vec3::new(p[0], p[1], p[2])),
-        );
-        let all = |len: usize, per: usize| len == count * per && count > 0;
-        if all(mm.normals.len(), 3) {
-            m.normals.extend(
-                mm.normals
-                    .chunks_exact(3)
-                    .map(|p| Vec3::new(p[0], p[1], p[2])),
-            );
-        }
-        if all(mm.texcoords.len(), 2) {
-            m.uvs
-                .extend(mm.texcoords.chunks_exact(2).map(|p| Vec2::new(p[0], p[1])));
-        }
-        if all(mm.vertex_color.len(), 3) {
-            m.colors.extend(
-                mm.vertex_color
-                    .chunks_exact(3)
-                    .map(|p| Vec3::new(p[0], p[1], p[2])),
-            );
-        }
-        m.indices.extend(mm.indices.iter().map(|i| i + base));
+/// A power of two that brings the largest |coordinate| of `positions` near 1 if it
+/// is beyond what f32 holds comfortably (above 1e30 or below 1e-30, zero aside),
+/// else 1: exact, so the model's shape is kept to the last bit.
+fn power_of_two_scale(positions: &[[f64; 3]]) -> f64 {
+    let max = positions
+        .iter()
+        .flatten()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    if max == 0.0 || !max.is_finite() || (1e-30..=1e30).contains(&max) {
+        return 1.0;
     }
-    // An attribute counts only if every model supplied it.
-    let n = m.positions.len();
-    if m.normals.len() != n {
-        m.normals.clear();
-    }
-    if m.uvs.len() != n {
-        m.uvs.clear();
-    }
-    if m.colors.len() != n {
-        m.colors.clear();
-    }
-    if let Some(bad) = m.positions.iter().position(|p| !p.is_finite()) {
-        return Err(MeshError::Malformed {
-            path: path.into(),
-            line: nth_line_starting(text, "v", bad),
-            problem: "vertex position is not a finite number".into(),
-        });
-    }
-    if m.indices.is_empty() {
-        return Err(MeshError::Empty { path: path.into() });
-    }
-    Ok(m)
-}
-
-/// Line number (1-based) of the `n`-th line whose first word is `word`.
-fn nth_line_starting(text: &str, word: &str, n: usize) -> Option<usize> {
-    text.lines()
-        .enumerate()
-        .filter(|(_, l)| l.split_whitespace().next() == Some(word))
-        .nth(n)
-        .map(|(i, _)| i + 1)
-}
-
-/// tobj reports what went wrong but not where: find the first line that shows it.
-fn locate_error(text: &str, e: tobj::LoadError) -> (Option<usize>, String) {
-    use tobj::LoadError as E;
-    let floats = |rest: &[&str], min: usize| {
-        rest.len() >= min && rest.iter().all(|s| s.parse::<f32>().is_ok())
-    };
-    let counts = |t: &str| {
-        t.lines()
-            .filter(|l| l.split_whitespace().next() == Some("v"))
-            .count()
-    };
-    let nv = counts(text) as i64;
-    let bad_face = |rest: &[&str]| {
-        rest.len() < 3
-            || rest.iter().any(|c| {
-                c.split('/')
-                    .next()
-                    .and_then(|v| v.parse::<i64>().ok())
-                    .is_none_or(|i| i == 0 || i > nv || i < -nv)
-            })
-    };
-    let test = |w: &str, r: &[&str]| match e {
-        E::PositionParseError => w == "v" && !floats(r, 3),
-        E::NormalParseError => w == "vn" && !floats(r, 3),
-        E::TexcoordParseError => w == "vt" && !floats(r, 1),
-        E::FaceParseError | E::InvalidPolygon | E::FaceVertexOutOfBounds => w == "f" && bad_face(r),
-        _ => false,
-    };
-    let line = text.lines().enumerate().find_map(|(i, l)| {
-        let mut words = l.split_whitespace();
-        let w = words.next()?;
-        let rest: Vec<&str> = words.collect();
-        test(w, &rest).then_some(i + 1)
-    });
-    let what = match e {
-        E::PositionParseError => "bad vertex position (`v x y z`)".to_string(),
-        E::NormalParseError => "bad normal (`vn x y z`)".to_string(),
-        E::TexcoordParseError => "bad texture coordinate (`vt u v`)".to_string(),
-        E::FaceParseError | E::InvalidPolygon => "bad face (`f i j k ...`)".to_string(),
-        E::FaceVertexOutOfBounds => {
-            format!("face refers to a vertex that does not exist (there are {nv})")
-        }
-        other => other.to_string(),
-    };
-    (line, what)
+    2f64.powi(-(max.log2().round() as i32))
 }

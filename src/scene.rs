@@ -4,7 +4,7 @@
 //! # The file
 //!
 //! The minimal scene is one `[[object]]` with `model = "teapot"` (or `bunny`,
-//! `sphere:N`, or an OBJ path relative to the scene file). Every other key has a
+//! `sphere:N`, or a model file relative to the scene file). Every other key has a
 //! default and every effect is off: such a scene is the model's silhouette in flat
 //! white, drawn in order without a depth buffer. See `examples/scenes/` for the rest:
 //!
@@ -20,7 +20,8 @@
 //! [object.material]        # color, lighting = "none" | "flat" | "gouraud" |
 //!                          # "lambert" | "blinn-phong", specular, shininess,
 //!                          # vertex_colors, texture = "off" | "nearest" | "bilinear",
-//!                          # image (a PNG instead of the OBJ material's map_Kd)
+//!                          # image (a PNG instead of the OBJ material's map_Kd),
+//!                          # from_model (the model file's materials, too)
 //! [object.effects]         # depth_test, cull, fog = { start, end, color },
 //!                          # depth_shading, wireframe, silhouette
 //! ```
@@ -39,6 +40,8 @@
 //! silhouettes.
 
 pub mod file;
+mod load;
+pub use load::MAX_SCENE_TRIANGLES;
 pub mod plan;
 pub mod render;
 pub mod texture;
@@ -146,6 +149,9 @@ pub struct Material {
     /// A texture image given in the scene (else the model's map_Kd); a path ending
     /// in [`BUILTIN_CHECKER`] with no extension is the built-in checkerboard.
     pub image: Option<PathBuf>,
+    /// Take the model file's own materials too: its diffuse colours (one object per
+    /// material), textures and vertex colours (a model's default scene does).
+    pub from_model: bool,
 }
 
 impl From<(&MaterialFile, &Path)> for Material {
@@ -158,6 +164,7 @@ impl From<(&MaterialFile, &Path)> for Material {
             vertex_colors: m.vertex_colors,
             texture: m.texture,
             image: m.image.as_deref().map(|i| file::relative(i, scene)),
+            from_model: m.from_model,
         }
     }
 }
@@ -205,6 +212,8 @@ pub struct Scene {
     pub lights: Vec<LightDesc>,
     pub objects: Vec<SceneObject>,
     pub plan: Plan,
+    /// What the model loaders went past (file and line each), for the user.
+    pub warnings: Vec<String>,
 }
 
 /// The ambient term of [`standard_lights`] (the lane-code Lambert of the standard
@@ -237,12 +246,12 @@ pub fn is_scene_path(spec: &str) -> bool {
 }
 
 impl Scene {
-    /// The default scene of a model (what an OBJ path is shorthand for): the model
+    /// The default scene of a model (what a model path is shorthand for): the model
     /// with depth test and per-pixel Lambert under the standard lights, its bounding
     /// sphere framed, turning on a turntable, as the viewer and `render` show it.
     pub fn for_model(spec: &str) -> Result<Self, SceneError> {
         let text = format!(
-            "[[object]]\nmodel = {}\n[object.material]\nlighting = \"lambert\"\n[object.effects]\ndepth_test = true\n",
+            "[[object]]\nmodel = {}\n[object.material]\nlighting = \"lambert\"\nfrom_model = true\n[object.effects]\ndepth_test = true\n",
             toml::Value::String(spec.to_string())
         );
         let mut scene =
@@ -251,7 +260,11 @@ impl Scene {
                 e => e,
             })?;
         scene.source = format!("{spec} (default scene)");
-        let radius = scene.objects[0].mesh.bounding_radius();
+        let radius = scene
+            .objects
+            .iter()
+            .map(|o| o.mesh.bounding_radius())
+            .fold(0.0, f32::max);
         scene.rig = Rig::Turntable {
             framing: Some(radius),
         };
@@ -338,9 +351,18 @@ impl Scene {
 
     /// Reads and loads a scene file.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        // Only a regular file, and not without end: a FIFO or a device would hang.
+        let bytes = crate::mesh::read::read_regular(path, 16 << 20).map_err(|e| match e {
+            MeshError::Io { path, source } => SceneError::Io { path, source },
+            e => SceneError::Mesh(e),
+        })?;
+        let text = String::from_utf8(bytes).map_err(|e| SceneError::Invalid {
             path: path.into(),
-            source,
+            line: None,
+            problem: format!(
+                "not text (byte {} is not UTF-8)",
+                e.utf8_error().valid_up_to()
+            ),
         })?;
         Self::from_text(&text, path)
     }
@@ -398,12 +420,13 @@ impl Scene {
                 effects: o.effects,
             })
             .collect();
-        let plan = Plan::new(&descs, &lights, f.render.antialias);
-        let objects = descs
+        let (parts, warnings) = load::read_models(descs, path)?;
+        let part_descs: Vec<ObjectDesc> = parts.iter().map(|p| p.desc.clone()).collect();
+        let plan = Plan::new(&part_descs, &lights, f.render.antialias);
+        let objects = parts
             .into_iter()
             .zip(&plan.objects)
-            .enumerate()
-            .map(|(i, (desc, op))| load_object(desc, op, path, i + 1))
+            .map(|(part, op)| load::load_object(part, op, path))
             .collect::<Result<Vec<_>, _>>()?;
         let camera = camera.unwrap_or_else(|| framing(&objects));
         Ok(Self {
@@ -414,6 +437,7 @@ impl Scene {
             lights,
             objects,
             plan,
+            warnings,
         })
     }
 }
@@ -442,125 +466,4 @@ fn framing(objects: &[SceneObject]) -> Camera {
     camera.target += centre;
     camera.eye += centre;
     camera
-}
-
-/// Loads an object's model and keeps, derives and drops exactly what its plan says.
-fn load_object(
-    desc: ObjectDesc,
-    op: &plan::ObjectPlan,
-    scene: &Path,
-    n: usize,
-) -> Result<SceneObject, SceneError> {
-    let mut mesh = Mesh::from_spec(&desc.model).map_err(|source| SceneError::Model {
-        scene: scene.into(),
-        object: n,
-        source,
-    })?;
-    let unsupported = |problem: String| SceneError::Unsupported {
-        scene: scene.into(),
-        object: n,
-        model: desc.model.clone(),
-        problem,
-    };
-    if op.vertex_colors && mesh.colors.is_empty() {
-        return Err(unsupported(
-            "material.vertex_colors = true, but the model has no vertex colours (`v x y z r g b`)"
-                .into(),
-        ));
-    }
-    if op.uvs && mesh.uvs.is_empty() {
-        return Err(unsupported(
-            "material.texture is on, but the model has no texture coordinates (`vt`)".into(),
-        ));
-    }
-    let texture = if op.texture == TextureMode::Off {
-        None
-    } else {
-        if desc
-            .material
-            .image
-            .as_deref()
-            .is_some_and(|i| i.ends_with(BUILTIN_CHECKER))
-        {
-            Some(Texture::checker(
-                64,
-                64,
-                8,
-                Vec3::new(0.9, 0.55, 0.16),
-                Vec3::new(0.16, 0.35, 0.8),
-            ))
-        } else {
-            let file = match (&desc.material.image, &mesh.texture) {
-                (Some(image), _) => image.clone(),
-                (None, Ok(Some(t))) => t.clone(),
-                (None, Ok(None)) => {
-                    return Err(unsupported(
-                    "material.texture is on, but the model's material has no map_Kd: set material.image".into(),
-                ));
-                }
-                (None, Err(problem)) => return Err(unsupported(problem.clone())),
-            };
-            Some(Texture::load(&file)?)
-        }
-    };
-    // Drop what no stage reads: the mesh then holds exactly the attributes the plan
-    // transforms.
-    if !op.vertex_colors {
-        mesh.colors = Vec::new();
-    }
-    if !op.uvs {
-        mesh.uvs = Vec::new();
-    }
-    // Edge topology comes from the mesh as loaded, with vertices identified by
-    // position (so texture seams and the per-face split below are not edges).
-    let topology = op.edges.then(|| Topology::of(&mesh));
-    let mut face_centres = Vec::new();
-    if op.unweld {
-        // Flat lighting: every face gets its own three vertices with the face normal.
-        let mut flat = Mesh {
-            name: mesh.name.clone(),
-            texture: mesh.texture.clone(),
-            ..Mesh::default()
-        };
-        for t in mesh.indices.chunks_exact(3) {
-            let p = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
-            let normal = (p[1] - p[0])
-                .cross(p[2] - p[0])
-                .try_normalize()
-                .unwrap_or(Vec3::Z);
-            let centre = (p[0] + p[1] + p[2]) / 3.0;
-            for &i in t {
-                flat.indices.push(flat.positions.len() as u32);
-                flat.positions.push(mesh.positions[i as usize]);
-                flat.normals.push(normal);
-                face_centres.push(centre);
-                if let Some(c) = mesh.colors.get(i as usize) {
-                    flat.colors.push(*c);
-                }
-                if let Some(uv) = mesh.uvs.get(i as usize) {
-                    flat.uvs.push(*uv);
-                }
-            }
-        }
-        mesh = flat;
-    } else if op.normals {
-        mesh.ensure_normals();
-    } else {
-        mesh.normals = Vec::new();
-    }
-    let (edges, edge_faces) = match topology {
-        Some(t) => {
-            let edges = t.drawn_edges(&mesh.indices);
-            (edges, if op.silhouette { t.faces } else { Vec::new() })
-        }
-        None => (Vec::new(), Vec::new()),
-    };
-    Ok(SceneObject {
-        desc,
-        mesh: std::sync::Arc::new(mesh),
-        edges,
-        edge_faces,
-        face_centres,
-        texture,
-    })
 }

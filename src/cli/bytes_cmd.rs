@@ -11,7 +11,7 @@ use crate::terminal::{ColorMode, GlyphMode};
 /// Arguments of `bench bytes`.
 #[derive(Debug, Args)]
 pub struct BytesArgs {
-    /// Models (`teapot`, `bunny`, `sphere:N`, an OBJ path).
+    /// Models (`teapot`, `bunny`, `sphere:N`, a model file).
     #[arg(default_values_t = ["teapot".to_string(), "bunny".to_string()])]
     pub models: Vec<String>,
     /// Cells, WxH.

@@ -9,7 +9,7 @@ use crate::slowlink::{self, Config};
 /// Arguments of `bench link`.
 #[derive(Debug, Args)]
 pub struct LinkArgs {
-    /// Models to view (`teapot`, `bunny`, `sphere:N`, an OBJ or scene path).
+    /// Models to view (`teapot`, `bunny`, `sphere:N`, a model file or a scene file).
     #[arg(default_values_t = ["teapot".to_string(), "bunny".to_string()])]
     pub models: Vec<String>,
     /// Link rates in bytes per second.

@@ -23,8 +23,8 @@ pub const RADIANS_PER_FRAME: f32 = 0.05;
 /// Options shared by the 3D commands.
 #[derive(Debug, Args)]
 pub struct SceneArgs {
-    /// `teapot` or `bunny` (built in), `sphere:N` (UV sphere of about N triangles), an
-    /// OBJ path, or (for `render`) a scene file `SCENE.toml`.
+    /// `teapot` or `bunny` (built in), `sphere:N` (UV sphere of about N triangles), a
+    /// model file (OBJ, STL, PLY, glTF), or (for `render`) a scene file `SCENE.toml`.
     #[arg(default_value = "teapot")]
     pub model: String,
     /// Skip back faces (a model; a scene file's effects say).
@@ -282,12 +282,13 @@ impl std::fmt::Display for BenchReport {
 pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliError> {
     if is_scene_path(&args.scene.model) {
         return Err(super::CliError::Usage(format!(
-            "{0}: bench render times a model (`teapot`, `bunny`, `sphere:N` or an OBJ file), \
+            "{0}: bench render times a model (`teapot`, `bunny`, `sphere:N` or a model file), \
              not a scene file; `termrast render {0}` draws the scene",
             args.scene.model
         )));
     }
     let mut scene = Scene::standard(&args.scene.model)?;
+    super::view_cmd::print_warnings(&scene.warnings, &mut std::io::stderr().lock());
     scene.set_mode(args.scene.mode);
     scene.set_cull(args.scene.cull);
     let target = args.size;

@@ -94,8 +94,8 @@ impl LookArgs {
 /// Arguments of the viewer.
 #[derive(Debug, Args, Clone)]
 pub struct ViewArgs {
-    /// `teapot` or `bunny` (built in), `sphere:N`, an OBJ path, or a scene file
-    /// `SCENE.toml`.
+    /// `teapot` or `bunny` (built in), `sphere:N`, a model file (OBJ, STL, PLY,
+    /// glTF), or a scene file `SCENE.toml`.
     #[arg(default_value = "teapot")]
     pub model: String,
     #[command(flatten)]
@@ -121,14 +121,36 @@ pub struct ViewArgs {
 
 /// A scene file (`SCENE.toml`), or a model's default scene drawn in `mode`, culled
 /// with `cull` (a scene file's effects say how it is drawn).
+/// What the loaders warned of goes to stderr (it stays on the terminal's main screen,
+/// under the viewer's alternate screen, for after it).
 pub fn load(spec: &str, mode: Mode, cull: bool) -> Result<Scene, SceneError> {
-    if is_scene_path(spec) {
-        return Scene::load(std::path::Path::new(spec));
-    }
-    let mut scene = Scene::for_model(spec)?;
-    scene.set_mode(mode);
-    scene.set_cull(cull);
+    let scene = if is_scene_path(spec) {
+        Scene::load(std::path::Path::new(spec))?
+    } else {
+        let mut scene = Scene::for_model(spec)?;
+        scene.set_mode(mode);
+        scene.set_cull(cull);
+        scene
+    };
+    print_warnings(&scene.warnings, &mut io::stderr().lock());
     Ok(scene)
+}
+
+/// The most warnings printed; the rest are counted.
+const MAX_WARNINGS: usize = 20;
+
+/// Prints loader warnings, one per line.
+pub fn print_warnings(warnings: &[String], out: &mut impl Write) {
+    for w in warnings.iter().take(MAX_WARNINGS) {
+        let _ = writeln!(out, "termrast: warning: {w}");
+    }
+    if warnings.len() > MAX_WARNINGS {
+        let _ = writeln!(
+            out,
+            "termrast: warning: … and {} more",
+            warnings.len() - MAX_WARNINGS
+        );
+    }
 }
 
 /// Runs the viewer.
@@ -138,8 +160,16 @@ pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
         return Err(crate::tui::ViewError::Unsupported(why).into());
     }
     let scene = load(&args.model, args.mode, args.cull)?;
+    let warned = scene.warnings.len();
     let mut app = App::new(scene, args.look.settings());
-    app.notice = args.look.notice_in(env);
+    app.notice = args.look.notice_in(env).or_else(|| {
+        (warned > 0).then(|| {
+            format!(
+                "the model loaded with {warned} warning{}: printed under the viewer, seen after q",
+                if warned == 1 { "" } else { "s" }
+            )
+        })
+    });
     crate::tui::run(
         app,
         crate::tui::RunOptions {

@@ -123,7 +123,10 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh, MeshError> {
         }
     })?;
     if m.indices.is_empty() {
-        return Err(MeshError::Empty { path: path.into() });
+        return Err(MeshError::Empty {
+            path: path.into(),
+            note: String::new(),
+        });
     }
     m.name = path.display().to_string();
     Ok(m)

@@ -149,7 +149,7 @@ pub enum TextureMode {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectFile {
-    /// `teapot`, `bunny`, `sphere:N`, or an OBJ path relative to the scene file.
+    /// `teapot`, `bunny`, `sphere:N`, or a model file relative to the scene file.
     pub model: String,
     #[serde(default)]
     pub position: [f32; 3],
@@ -203,6 +203,9 @@ pub struct MaterialFile {
     /// A PNG to use instead of the OBJ material's `map_Kd` (relative to the scene), or
     /// `checker` for a built-in 64×64 checkerboard.
     pub image: Option<String>,
+    /// Also use the model file's materials: `Kd` colours per `usemtl` (or glTF base
+    /// colours), their textures and the vertex colours.
+    pub from_model: bool,
 }
 
 impl Default for MaterialFile {
@@ -215,6 +218,7 @@ impl Default for MaterialFile {
             vertex_colors: false,
             texture: TextureMode::Off,
             image: None,
+            from_model: false,
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Textures: PNG images sampled by texture coordinates, nearest or bilinear.
+//! Textures: images (PNG, JPEG, BMP, TGA, GIF) sampled by texture coordinates, nearest or bilinear.
 //!
 //! Coordinates follow OBJ: (0, 0) is the bottom-left of the image, (1, 1) the top
 //! right, and the texture repeats outside [0, 1]. Texel centres are at
@@ -12,6 +12,11 @@ use glam::{Vec2, Vec3};
 use super::SceneError;
 use super::file::TextureMode;
 use crate::counters::{self, Stage};
+use crate::mesh::read::read_regular;
+use crate::mesh::{MAX_MODEL_BYTES, MeshError, TextureSource};
+
+/// The most pixels a texture may have (8192 × 8192): its texels take 12 bytes each.
+pub const MAX_TEXTURE_PIXELS: u64 = 1 << 26;
 
 /// An RGB image for sampling.
 #[derive(Clone, Debug, PartialEq)]
@@ -23,19 +28,56 @@ pub struct Texture {
 }
 
 impl Texture {
-    /// Reads a PNG (or any format the `image` crate was built with).
+    /// Reads an image file: PNG, JPEG, BMP, TGA or GIF. Only a regular file is read,
+    /// and an image of more than [`MAX_TEXTURE_PIXELS`] is refused from its header,
+    /// before it is decoded.
     pub fn load(path: &Path) -> Result<Self, SceneError> {
-        let img = image::open(path).map_err(|e| SceneError::Texture {
+        let bytes = read_regular(path, MAX_MODEL_BYTES).map_err(|e| SceneError::Texture {
             path: path.into(),
-            problem: e.to_string(),
+            problem: match e {
+                MeshError::Io { source, .. } => source.to_string(),
+                MeshError::NotRegular { what, .. } => format!("{what}, not an image file"),
+                e => e.to_string().replace(&format!("{}: ", path.display()), ""),
+            },
         })?;
+        Self::decode(&bytes, path)
+    }
+
+    /// Reads a model's texture, from its file or from the bytes inside the model.
+    pub fn from_source(source: &TextureSource) -> Result<Self, SceneError> {
+        match source {
+            TextureSource::File(path) => Self::load(path),
+            TextureSource::Embedded { name, bytes } => Self::decode(bytes, Path::new(name)),
+        }
+    }
+
+    fn decode(bytes: &[u8], path: &Path) -> Result<Self, SceneError> {
+        let problem = |problem: String| SceneError::Texture {
+            path: path.into(),
+            problem,
+        };
+        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| problem(e.to_string()))?;
+        let (width, height) = reader
+            .into_dimensions()
+            .map_err(|e| problem(e.to_string()))?;
+        if u64::from(width) * u64::from(height) > MAX_TEXTURE_PIXELS {
+            return Err(problem(format!(
+                "{width}×{height} is more than the {MAX_TEXTURE_PIXELS} pixels a texture may have"
+            )));
+        }
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| problem(e.to_string()))?;
+        let mut limits = image::Limits::default();
+        limits.max_alloc = Some(MAX_TEXTURE_PIXELS * 16);
+        reader.limits(limits);
+        let img = reader.decode().map_err(|e| problem(e.to_string()))?;
         let rgb = img.to_rgb8();
         let (width, height) = rgb.dimensions();
         if width == 0 || height == 0 {
-            return Err(SceneError::Texture {
-                path: path.into(),
-                problem: "the image is empty".into(),
-            });
+            return Err(problem("the image is empty".into()));
         }
         Ok(Self {
             width,

@@ -91,8 +91,9 @@ pub fn inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub: usiz
         return t;
     };
     let scene = &s.scene;
-    // A scene file's objects are named; a model's default scene is the model.
-    let named = !scene.is_model();
+    // A scene file's objects are named; a model's default scene is the model, or its
+    // parts by material.
+    let named = !scene.is_model() || scene.objects.len() > 1;
     let rows = listed(vp, n, sub);
     if rows.len() < n {
         t.fields(
@@ -122,7 +123,13 @@ pub fn inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub: usiz
                     String::new()
                 };
                 let shade = r.varying.map_or(0.0, luminance);
-                let shade = format!("shade {shade:.3}");
+                // Colour where there is any (materials, vertex colours, textures).
+                let shade = match r.varying {
+                    Some(c) if c.max_element() - c.min_element() > 1e-3 => {
+                        format!("shade {shade:.3} rgb {:.2} {:.2} {:.2}", c.x, c.y, c.z)
+                    }
+                    _ => format!("shade {shade:.3}"),
+                };
                 t.fields_or(
                     0,
                     [
@@ -172,7 +179,7 @@ pub fn inspector_text(vp: &Viewport, s: &SceneState, cx: u16, cy: u16, sub: usiz
         ],
     );
     for ((p, obj), op) in probes.iter().zip(&scene.objects).zip(&scene.plan.objects) {
-        if named {
+        if named || op.varyings.color || op.varyings.uv {
             t.fields(
                 0,
                 [

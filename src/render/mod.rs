@@ -50,6 +50,7 @@ pub mod probe;
 pub mod shader;
 pub mod shaders;
 pub mod target;
+mod tiles;
 pub mod wire;
 
 use glam::Vec3;
@@ -67,7 +68,8 @@ pub use prepare::{
     prepare_projected, project_vertices, transform,
 };
 pub use shader::{ShadeLanes, Shader};
-pub use target::{ColorTarget, Rgba8};
+pub use target::{ColorTarget, Rgba8, Rgba8Rows};
+pub use tiles::BAND_ROWS;
 
 /// Owns the depth buffer and frame counters; draws meshes into a colour target.
 #[derive(Debug)]
@@ -79,6 +81,10 @@ pub struct Renderer {
     pub isa: Isa,
     /// The current draw's vertex projections, reused between draws.
     projected: Vec<Projected>,
+    /// The threads draws run on ([`Renderer::set_threads`]); none for one thread.
+    pool: Option<rayon::ThreadPool>,
+    /// The threaded draws' set-up records and bins, reused between draws.
+    scratch: tiles::Scratch,
 }
 
 impl Renderer {
@@ -91,7 +97,63 @@ impl Renderer {
             stats: DrawStats::default(),
             isa: Isa::detect(),
             projected: Vec::new(),
+            pool: None,
+            scratch: tiles::Scratch::default(),
         }
+    }
+
+    /// Draws on `threads` threads from now on (at least 1). One thread is the
+    /// single-threaded path itself; more run every draw on a pool of that many
+    /// threads, built here once (see `tiles`), with the frame and counters one thread
+    /// gives. If the pool cannot be built, draws stay on one thread.
+    pub fn set_threads(&mut self, threads: usize) {
+        if threads == self.threads() {
+            return;
+        }
+        self.pool = (threads > 1)
+            .then(|| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .thread_name(|i| format!("termrast-draw-{i}"))
+                    .build()
+                    .ok()
+            })
+            .flatten();
+    }
+
+    /// The threads draws run on.
+    #[must_use]
+    pub fn threads(&self) -> usize {
+        self.pool
+            .as_ref()
+            .map_or(1, rayon::ThreadPool::current_num_threads)
+    }
+
+    /// [`transform`] on the renderer's threads: the same vertices, in chunks of
+    /// the vertex array.
+    pub fn transform<S: Shader>(
+        &self,
+        shader: &S,
+        vertex_count: usize,
+        cache: &mut VertexCache<S::Varying>,
+    ) {
+        let Some(pool) = &self.pool else {
+            transform(shader, vertex_count, cache);
+            return;
+        };
+        pool.install(|| {
+            use rayon::prelude::*;
+            cache.verts.clear();
+            cache.verts.par_extend(
+                (0..vertex_count as u32)
+                    .into_par_iter()
+                    .with_min_len(tiles::VERTEX_JOB)
+                    .map(|i| {
+                        let (pos, var) = shader.vertex(i);
+                        crate::raster::clip::ClipVertex { pos, var }
+                    }),
+            );
+        });
     }
 
     /// Starts a frame: clears depth and colour (reallocating only on resize) and the
@@ -167,7 +229,7 @@ impl Renderer {
         let mut projected = std::mem::take(&mut self.projected);
         project_vertices(cache, target, &mut projected);
         let mut walker =
-            PieceWalker::<S, C, L, V>::new(shader, &mut self.depth, color, opts, target);
+            PieceWalker::<S, C, L, V, _>::new(shader, &mut self.depth, color, opts, target);
         let n = (indices.len() / 3) as u32;
         for t in 0..n {
             walker.stats.triangles += 1;

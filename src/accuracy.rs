@@ -387,6 +387,9 @@ impl ColorTarget for UvTarget {
         self.0.clear();
         self.0.resize(len, [f32::NAN; 2]);
     }
+    fn len(&self) -> usize {
+        self.0.len()
+    }
 
     type Rows<'a> = UvRows<'a>;
 
@@ -405,6 +408,9 @@ impl ColorTarget for UvRows<'_> {
     }
     fn reset(&mut self, _: usize, _: Vec3) {
         self.0.fill([f32::NAN; 2]);
+    }
+    fn len(&self) -> usize {
+        self.0.len()
     }
 
     type Rows<'a>

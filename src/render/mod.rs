@@ -53,6 +53,8 @@ pub mod target;
 mod tiles;
 pub mod wire;
 
+use std::sync::Arc;
+
 use glam::Vec3;
 
 use crate::counters::{self, Stage};
@@ -82,7 +84,7 @@ pub struct Renderer {
     /// The current draw's vertex projections, reused between draws.
     projected: Vec<Projected>,
     /// The threads draws run on ([`Renderer::set_threads`]); none for one thread.
-    pool: Option<rayon::ThreadPool>,
+    pool: Option<Arc<rayon::ThreadPool>>,
     /// The threaded draws' set-up records and bins, reused between draws.
     scratch: tiles::Scratch,
 }
@@ -117,6 +119,7 @@ impl Renderer {
                     .thread_name(|i| format!("termrast-draw-{i}"))
                     .build()
                     .ok()
+                    .map(Arc::new)
             })
             .flatten();
     }
@@ -126,7 +129,15 @@ impl Renderer {
     pub fn threads(&self) -> usize {
         self.pool
             .as_ref()
-            .map_or(1, rayon::ThreadPool::current_num_threads)
+            .map_or(1, |p| p.current_num_threads())
+    }
+
+    /// The pool draws run on, if more than one thread: a caller that runs a whole
+    /// frame inside it (`install`) hands the frame to its threads once, instead of
+    /// once per step.
+    #[must_use]
+    pub fn pool(&self) -> Option<&Arc<rayon::ThreadPool>> {
+        self.pool.as_ref()
     }
 
     /// [`transform`] on the renderer's threads: the same vertices, in chunks of
@@ -179,7 +190,20 @@ impl Renderer {
         } else {
             self.depth = DepthBuffer::empty(target.width, target.height);
         }
-        color.reset(target.len(), background);
+        match &self.pool {
+            // The clear is a pass over the whole frame: shared out by bands too.
+            Some(pool) if color.len() == target.len() && !target.is_empty() => {
+                use rayon::prelude::*;
+                let band = BAND_ROWS as usize * target.width as usize;
+                pool.install(|| {
+                    color.bands(band).for_each(|mut b| {
+                        let len = b.len();
+                        b.reset(len, background);
+                    });
+                });
+            }
+            _ => color.reset(target.len(), background),
+        }
         self.stats = DrawStats::default();
     }
 

@@ -14,6 +14,8 @@ pub trait ColorTarget: Send {
     fn put(&mut self, index: usize, c: Vec3);
     /// Fills the whole target, resizing to `len` pixels only if needed.
     fn reset(&mut self, len: usize, c: Vec3);
+    /// Pixels held.
+    fn len(&self) -> usize;
 
     /// Writes colour lane `k` (red, green, blue lanes) of a group for each set bit `k`
     /// of `mask`: to pixel `start + (k / 8)·stride + k % 8` (8 lanes per row, `F::ROWS`
@@ -80,6 +82,24 @@ fn blend_lanes<I: I32s>(out: &mut [[u8; 4]], start: usize, stride: usize, mask: 
     px.store_rows(bytemuck::cast_slice_mut(out), start, stride, mask);
 }
 
+/// The cleared pixel of background `c`: alpha 0, nothing covered.
+fn background(c: Vec3) -> [u8; 4] {
+    [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0]
+}
+
+/// Fills `out` with background `c`.
+fn fill_rgba(out: &mut [[u8; 4]], c: Vec3) {
+    let px = background(c);
+    if px == [0; 4] {
+        // Black (the usual background): a byte fill, which compiles to `memset`,
+        // whose string stores clear a large frame without reading it first. A fill
+        // of 4-byte words is a vector loop that reads every line it writes.
+        bytemuck::cast_slice_mut::<[u8; 4], u8>(out).fill(0);
+    } else {
+        out.fill(px);
+    }
+}
+
 /// [`ColorTarget::put`] of [`Rgba8`] and its bands.
 #[inline(always)]
 fn put_rgba(out: &mut [[u8; 4]], index: usize, c: Vec3) {
@@ -126,19 +146,16 @@ impl ColorTarget for Rgba8 {
         put_lanes_grey_rgba(&mut self.0, start, stride, mask, g);
     }
     fn reset(&mut self, len: usize, c: Vec3) {
-        let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0];
         if self.0.len() != len {
             self.0.clear();
             crate::memory::reserve_frame(&mut self.0, len);
-            self.0.resize(len, px);
-        } else if px == [0; 4] {
-            // Black (the usual background): a byte fill, which compiles to `memset`,
-            // whose string stores clear a large frame without reading it first. A fill
-            // of 4-byte words is a vector loop that reads every line it writes.
-            bytemuck::cast_slice_mut::<[u8; 4], u8>(&mut self.0).fill(0);
+            self.0.resize(len, background(c));
         } else {
-            self.0.fill(px);
+            fill_rgba(&mut self.0, c);
         }
+    }
+    fn len(&self) -> usize {
+        self.0.len()
     }
 
     type Rows<'a> = Rgba8Rows<'a>;
@@ -168,7 +185,10 @@ impl ColorTarget for Rgba8Rows<'_> {
     /// Fills the band (it cannot change size).
     fn reset(&mut self, len: usize, c: Vec3) {
         debug_assert_eq!(len, self.0.len(), "a band keeps its size");
-        self.0.fill([to_u8(c.x), to_u8(c.y), to_u8(c.z), 0]);
+        fill_rgba(self.0, c);
+    }
+    fn len(&self) -> usize {
+        self.0.len()
     }
 
     type Rows<'a>

@@ -105,6 +105,9 @@ impl ColorTarget for Exact {
         self.writes.clear();
         self.writes.resize(len, 0);
     }
+    fn len(&self) -> usize {
+        self.colors.len()
+    }
 
     type Rows<'a> = ExactRows<'a>;
 
@@ -134,6 +137,9 @@ impl ColorTarget for ExactRows<'_> {
     fn reset(&mut self, _: usize, _: Vec3) {
         self.colors.fill(None);
         self.writes.fill(0);
+    }
+    fn len(&self) -> usize {
+        self.colors.len()
     }
 
     type Rows<'a>

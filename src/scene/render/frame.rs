@@ -55,7 +55,7 @@ pub struct SceneFrame {
     pub color: Rgba8,
     /// The supersampled frame (empty when the plan has no supersampling).
     fine: Rgba8,
-    pipelines: Vec<Box<dyn ObjectPipeline>>,
+    pipelines: Vec<Box<dyn ObjectPipeline + Send>>,
     pub silhouettes: Vec<Silhouette>,
     /// Counters of the last frame, all objects.
     pub stats: DrawStats,
@@ -134,6 +134,16 @@ impl SceneFrame {
 
     /// Draws a frame of `target` samples.
     pub fn draw(&mut self, scene: &Scene, target: Target, view: &SceneView) {
+        match self.renderer.pool().cloned() {
+            // The whole frame on the pool: its steps then start their parallel work
+            // from one of its threads, without waking the pool for each.
+            Some(pool) => pool.install(|| self.draw_here(scene, target, view)),
+            None => self.draw_here(scene, target, view),
+        }
+    }
+
+    /// [`SceneFrame::draw`] on the calling thread.
+    fn draw_here(&mut self, scene: &Scene, target: Target, view: &SceneView) {
         let start = Instant::now();
         let plan = &scene.plan;
         let side = grid_side(plan.samples);

@@ -347,8 +347,8 @@ pub fn pipeline_for(
     obj: &SceneObject,
     plan: &ObjectPlan,
     lights: &[LightDesc],
-) -> Box<dyn ObjectPipeline> {
-    fn new<S: Shading>(varyings: VaryingSet) -> Box<dyn ObjectPipeline> {
+) -> Box<dyn ObjectPipeline + Send> {
+    fn new<S: Shading>(varyings: VaryingSet) -> Box<dyn ObjectPipeline + Send> {
         Box::new(Pipeline::<S> {
             cache: VertexCache::default(),
             varyings,

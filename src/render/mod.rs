@@ -87,6 +87,8 @@ pub struct Renderer {
     pool: Option<Arc<rayon::ThreadPool>>,
     /// The threaded draws' set-up records and bins, reused between draws.
     scratch: tiles::Scratch,
+    /// Rows per band of a threaded draw.
+    band_rows: u32,
 }
 
 impl Renderer {
@@ -101,6 +103,7 @@ impl Renderer {
             projected: Vec::new(),
             pool: None,
             scratch: tiles::Scratch::default(),
+            band_rows: BAND_ROWS,
         }
     }
 
@@ -109,6 +112,13 @@ impl Renderer {
     /// threads, built here once (see `tiles`), with the frame and counters one thread
     /// gives. If the pool cannot be built, draws stay on one thread.
     pub fn set_threads(&mut self, threads: usize) {
+        // Measurement only: the band height.
+        if let Some(b) = std::env::var("TERMRAST_BAND_ROWS")
+            .ok()
+            .and_then(|v| v.parse().ok())
+        {
+            self.band_rows = b;
+        }
         if threads == self.threads() {
             return;
         }
@@ -127,9 +137,7 @@ impl Renderer {
     /// The threads draws run on.
     #[must_use]
     pub fn threads(&self) -> usize {
-        self.pool
-            .as_ref()
-            .map_or(1, |p| p.current_num_threads())
+        self.pool.as_ref().map_or(1, |p| p.current_num_threads())
     }
 
     /// The pool draws run on, if more than one thread: a caller that runs a whole
@@ -194,7 +202,7 @@ impl Renderer {
             // The clear is a pass over the whole frame: shared out by bands too.
             Some(pool) if color.len() == target.len() && !target.is_empty() => {
                 use rayon::prelude::*;
-                let band = BAND_ROWS as usize * target.width as usize;
+                let band = self.band_rows as usize * target.width as usize;
                 pool.install(|| {
                     color.bands(band).for_each(|mut b| {
                         let len = b.len();

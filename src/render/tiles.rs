@@ -49,6 +49,10 @@ use crate::simd::I32s;
 /// Chosen by measurement (see `docs/performance.md`).
 pub const BAND_ROWS: u32 = 32;
 
+/// Triangles per chunk of a batch (see [`draw`]): a batch's records stay a few
+/// megabytes however large the mesh.
+const CHUNK_TRIANGLES: usize = 4096;
+
 /// Chunks of triangles per thread in the set-up step: enough that a thread that
 /// finishes early takes another.
 const CHUNKS_PER_THREAD: usize = 4;
@@ -128,6 +132,8 @@ pub(super) struct Job<'a, S: Shader> {
     indices: &'a [u32],
     opts: DrawOptions,
     target: Target,
+    /// Rows per band (a multiple of 8).
+    band_rows: u32,
 }
 
 /// The two steps of a threaded draw that run a copy of the draw loop, compiled for
@@ -170,9 +176,10 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
         unreachable!("a threaded draw without a pool");
     };
     let target = r.target;
-    let bands = target.height.div_ceil(BAND_ROWS) as usize;
-    let triangles = (indices.len() / 3) as u32;
-    let n = (pool.current_num_threads() * CHUNKS_PER_THREAD).clamp(1, triangles.max(1) as usize);
+    let band_rows = r.band_rows;
+    let bands = target.height.div_ceil(band_rows) as usize;
+    let triangles = indices.len() / 3;
+    let n = (pool.current_num_threads() * CHUNKS_PER_THREAD).clamp(1, triangles.max(1));
     let chunks = r.scratch.chunks::<S::Varying>(n, bands);
     let projected = &mut r.projected;
     let depth = &mut r.depth;
@@ -193,40 +200,48 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
             indices,
             opts: *opts,
             target,
+            band_rows,
         };
-        chunks
-            .par_iter_mut()
-            .enumerate()
-            .with_max_len(1)
-            .for_each(|(c, chunk)| {
-                let part = |c: usize| (u64::from(triangles) * c as u64 / n as u64) as u32;
-                // SAFETY: the caller's guarantee.
-                unsafe { T::setup(&job, part(c)..part(c + 1), chunk) };
-            });
-        let chunks = &*chunks;
-        let band_px = BAND_ROWS as usize * target.width as usize;
-        let colors = color.bands(band_px);
-        assert_eq!(
-            colors.len(),
-            bands,
-            "the colour target is not the frame's size"
-        );
-        let walked = colors
-            .zip(depth.bands(BAND_ROWS))
-            .enumerate()
-            .with_max_len(1)
-            .map(|(b, (mut color, mut depth))| {
-                // SAFETY: the caller's guarantee.
-                unsafe { T::walk(&job, chunks, b, &mut color, &mut depth) }
-            })
-            .reduce(DrawStats::default, |mut a, b| {
-                a += b;
-                a
-            });
-        chunks.iter().fold(walked, |mut a, c| {
-            a += c.stats;
-            a
-        })
+        let mut stats = DrawStats::default();
+        // Batches of triangles, each set up and then walked, so the records of a large
+        // mesh are a few megabytes reused, not one record per triangle of the mesh.
+        let batch = n * CHUNK_TRIANGLES;
+        for first in (0..triangles).step_by(batch) {
+            let count = batch.min(triangles - first);
+            let part = |c: usize| (first + count * c / n) as u32;
+            chunks
+                .par_iter_mut()
+                .enumerate()
+                .with_max_len(1)
+                .for_each(|(c, chunk)| {
+                    // SAFETY: the caller's guarantee.
+                    unsafe { T::setup(&job, part(c)..part(c + 1), chunk) };
+                });
+            let chunks = &*chunks;
+            let colors = color.bands(band_rows as usize * target.width as usize);
+            assert_eq!(
+                colors.len(),
+                bands,
+                "the colour target is not the frame's size"
+            );
+            let walked = colors
+                .zip(depth.bands(band_rows))
+                .enumerate()
+                .with_max_len(1)
+                .map(|(b, (mut color, mut depth))| {
+                    // SAFETY: the caller's guarantee.
+                    unsafe { T::walk(&job, chunks, b, &mut color, &mut depth) }
+                })
+                .reduce(DrawStats::default, |mut a, b| {
+                    a += b;
+                    a
+                });
+            stats += walked;
+            for c in chunks {
+                stats += c.stats;
+            }
+        }
+        stats
     });
     r.stats += stats;
 }
@@ -234,19 +249,41 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
 /// Files each piece into its chunk and the bins of the bands its box touches.
 struct Binner<'a, V> {
     chunk: &'a mut Chunk<V>,
+    band_rows: u32,
 }
 
 impl<V: Copy> EmitPiece<V> for Binner<'_, V> {
     #[inline(always)]
     fn piece(&mut self, p: &Prepared<V>) {
+        let b = p.setup.bbox;
+        // A box of at most four pixels covering none of them (most triangles of a mesh
+        // far denser than the pixels) would be walked for nothing: it is not stored.
+        // The stale depth tiles the walk would have filled read as cleared anyway.
+        if b.width() * b.height() <= 4 && !covers_any(&p.setup) {
+            return;
+        }
         let c = &mut *self.chunk;
         let i = c.records.len() as u32;
         c.records.push(*p);
-        let b = p.setup.bbox;
-        for band in b.y0 / BAND_ROWS..b.y1 / BAND_ROWS + 1 {
+        for band in b.y0 / self.band_rows..b.y1 / self.band_rows + 1 {
             c.bins[band as usize].push(i);
         }
     }
+}
+
+/// Whether any pixel of a setup's box is covered.
+#[inline(always)]
+fn covers_any(s: &Setup) -> bool {
+    let b = s.bbox;
+    for y in b.y0..=b.y1 {
+        for x in b.x0..=b.x1 {
+            let f = s.edges(i64::from(x), i64::from(y));
+            if f[0] >= 0 && f[1] >= 0 && f[2] >= 0 {
+                return true;
+            }
+        }
+    }
+    false
 }
 
 /// Sets up triangles `range` of the draw into `chunk`, counting them as one thread
@@ -262,7 +299,10 @@ pub(super) fn setup_chunk<S: Shader>(
         b.clear();
     }
     let mut stats = DrawStats::default();
-    let mut binner = Binner { chunk };
+    let mut binner = Binner {
+        chunk,
+        band_rows: job.band_rows,
+    };
     let pv = Some(job.projected);
     for t in range {
         stats.triangles += 1;
@@ -290,8 +330,8 @@ pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
     color: &mut C,
     depth: &mut DepthRows<'_>,
 ) -> DrawStats {
-    let y0 = band as u32 * BAND_ROWS;
-    let y1 = (y0 + BAND_ROWS).min(job.target.height) - 1;
+    let y0 = band as u32 * job.band_rows;
+    let y1 = (y0 + job.band_rows).min(job.target.height) - 1;
     let mut walker =
         PieceWalker::<S, C, L, V, _>::new(job.shader, depth, color, &job.opts, job.target);
     for chunk in chunks {

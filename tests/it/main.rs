@@ -21,5 +21,6 @@ mod model_frames;
 mod pipeline;
 mod scenes;
 mod terminal;
+mod threads;
 mod tmux;
 mod wire;

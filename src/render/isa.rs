@@ -140,7 +140,7 @@ pub(super) fn run<S: Shader, C: ColorTarget>(
     opts: &DrawOptions,
     color: &mut C,
 ) {
-    if r.pool.is_some() && !r.target.is_empty() {
+    if r.tiled() {
         run_tiled(copy, r, shader, cache, indices, opts, color);
         return;
     }
@@ -234,6 +234,8 @@ pub(super) mod baseline {
     use std::ops::Range;
 
     use super::DrawVariant;
+    use glam::Vec3;
+
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
     use crate::render::tiles::{self, Chunk, Job, TileCopy};
@@ -256,8 +258,9 @@ pub(super) mod baseline {
             band: usize,
             color: &mut C,
             depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
         ) -> DrawStats {
-            tiles::walk_band::<V, S, C, wide::i32x8>(job, chunks, band, color, depth)
+            tiles::walk_band::<V, S, C, wide::i32x8>(job, chunks, band, color, depth, clear)
         }
     }
 
@@ -281,6 +284,8 @@ pub(super) mod avx2 {
     use std::ops::Range;
 
     use super::DrawVariant;
+    use glam::Vec3;
+
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
     use crate::render::tiles::{self, Chunk, Job, TileCopy};
@@ -304,9 +309,10 @@ pub(super) mod avx2 {
             band: usize,
             color: &mut C,
             depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
-            unsafe { walk::<V, S, C>(job, chunks, band, color, depth) }
+            unsafe { walk::<V, S, C>(job, chunks, band, color, depth, clear) }
         }
     }
 
@@ -330,8 +336,9 @@ pub(super) mod avx2 {
         band: usize,
         color: &mut C,
         depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
     ) -> DrawStats {
-        tiles::walk_band::<V, S, C, crate::simd::avx2::I32x8>(job, chunks, band, color, depth)
+        tiles::walk_band::<V, S, C, crate::simd::avx2::I32x8>(job, chunks, band, color, depth, clear)
     }
 
     /// The draw loop of variant `V` compiled with AVX2 and FMA enabled and on
@@ -362,6 +369,8 @@ pub(super) mod avx512 {
     use std::ops::Range;
 
     use super::Fast;
+    use glam::Vec3;
+
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
     use crate::render::tiles::{self, Chunk, Job, TileCopy};
@@ -385,9 +394,10 @@ pub(super) mod avx512 {
             band: usize,
             color: &mut C,
             depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
-            unsafe { walk::<S, C>(job, chunks, band, color, depth) }
+            unsafe { walk::<S, C>(job, chunks, band, color, depth, clear) }
         }
     }
 
@@ -411,8 +421,9 @@ pub(super) mod avx512 {
         band: usize,
         color: &mut C,
         depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
     ) -> DrawStats {
-        tiles::walk_band::<Fast, S, C, crate::simd::avx512::I32x16>(job, chunks, band, color, depth)
+        tiles::walk_band::<Fast, S, C, crate::simd::avx512::I32x16>(job, chunks, band, color, depth, clear)
     }
 
     /// [`super::avx2::draw`]'s loop on 16 AVX-512 lanes in two-row groups (see

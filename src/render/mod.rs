@@ -89,6 +89,9 @@ pub struct Renderer {
     scratch: tiles::Scratch,
     /// Rows per band of a threaded draw.
     band_rows: u32,
+    /// The background of a colour clear left to the frame's first threaded draw
+    /// ([`Renderer::begin_frame_deferred`]).
+    pending_clear: Option<Vec3>,
 }
 
 impl Renderer {
@@ -104,6 +107,7 @@ impl Renderer {
             pool: None,
             scratch: tiles::Scratch::default(),
             band_rows: BAND_ROWS,
+            pending_clear: None,
         }
     }
 
@@ -191,6 +195,22 @@ impl Renderer {
         background: Vec3,
         depth: bool,
     ) {
+        self.begin_frame_deferred(target, color, background, depth);
+        self.finish_clear(color);
+    }
+
+    /// [`Renderer::begin_frame_with`], but on several threads the colour clear is left
+    /// to the frame's first draw, whose threads clear each band just before they walk
+    /// it (one pass over the frame fewer). The caller must call
+    /// [`Renderer::finish_clear`] before it touches the colour target other than by
+    /// [`Renderer::draw`].
+    pub fn begin_frame_deferred<C: ColorTarget>(
+        &mut self,
+        target: Target,
+        color: &mut C,
+        background: Vec3,
+        depth: bool,
+    ) {
         self.target = target;
         if depth {
             self.depth.reset(target.width, target.height);
@@ -198,21 +218,35 @@ impl Renderer {
         } else {
             self.depth = DepthBuffer::empty(target.width, target.height);
         }
-        match &self.pool {
-            // The clear is a pass over the whole frame: shared out by bands too.
-            Some(pool) if color.len() == target.len() && !target.is_empty() => {
-                use rayon::prelude::*;
-                let band = self.band_rows as usize * target.width as usize;
-                pool.install(|| {
-                    color.bands(band).for_each(|mut b| {
-                        let len = b.len();
-                        b.reset(len, background);
-                    });
-                });
-            }
-            _ => color.reset(target.len(), background),
+        self.pending_clear = None;
+        if self.tiled() && color.len() == target.len() {
+            self.pending_clear = Some(background);
+        } else {
+            color.reset(target.len(), background);
         }
         self.stats = DrawStats::default();
+    }
+
+    /// Clears the colour target if a deferred clear is still pending (no draw of the
+    /// frame took it), on the renderer's threads.
+    pub fn finish_clear<C: ColorTarget>(&mut self, color: &mut C) {
+        let (Some(background), Some(pool)) = (self.pending_clear.take(), &self.pool) else {
+            return;
+        };
+        use rayon::prelude::*;
+        let band = self.band_rows as usize * self.target.width as usize;
+        pool.install(|| {
+            color.bands(band).for_each(|mut b| {
+                let len = b.len();
+                b.reset(len, background);
+            });
+        });
+    }
+
+    /// Whether draws run on several threads ([`tiles`]): with a pool, on a target
+    /// with pixels.
+    fn tiled(&self) -> bool {
+        self.pool.is_some() && !self.target.is_empty()
     }
 
     /// Whether this frame has a depth buffer.
@@ -233,6 +267,9 @@ impl Renderer {
     ) {
         if opts.depth.uses_buffer() && !self.has_depth() {
             self.depth.reset(self.target.width, self.target.height);
+        }
+        if !self.tiled() {
+            self.finish_clear(color);
         }
         let copy = self.copy_for::<S>(opts);
         isa::run(copy, self, shader, cache, indices, opts, color);

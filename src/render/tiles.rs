@@ -29,6 +29,7 @@
 use std::any::Any;
 use std::ops::Range;
 
+use glam::Vec3;
 use rayon::prelude::*;
 
 use super::Renderer;
@@ -145,8 +146,9 @@ pub(super) trait TileCopy {
     /// The CPU must have the copy's instruction set.
     unsafe fn setup<S: Shader>(job: &Job<'_, S>, range: Range<u32>, chunk: &mut Chunk<S::Varying>);
 
-    /// Walks band `band` of every chunk into its rows of colour and depth (see
-    /// [`walk_band`]); returns its fragment counters.
+    /// Walks band `band` of every chunk into its rows of colour and depth, first
+    /// filling the colour rows with `clear` if given (see [`walk_band`]); returns its
+    /// fragment counters.
     ///
     /// # Safety
     /// As for [`TileCopy::setup`].
@@ -156,6 +158,7 @@ pub(super) trait TileCopy {
         band: usize,
         color: &mut C,
         depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
     ) -> DrawStats;
 }
 
@@ -183,6 +186,7 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
     let chunks = r.scratch.chunks::<S::Varying>(n, bands);
     let projected = &mut r.projected;
     let depth = &mut r.depth;
+    let mut clear = r.pending_clear.take();
     let stats = pool.install(|| {
         let guard = guard_band_ndc(target.width, target.height);
         projected.clear();
@@ -206,8 +210,10 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
         // Batches of triangles, each set up and then walked, so the records of a large
         // mesh are a few megabytes reused, not one record per triangle of the mesh.
         let batch = n * CHUNK_TRIANGLES;
-        for first in (0..triangles).step_by(batch) {
-            let count = batch.min(triangles - first);
+        // At least one batch: it also clears the colour if that is pending.
+        for first in (0..triangles.max(1)).step_by(batch) {
+            let count = batch.min(triangles.saturating_sub(first));
+            let clear = clear.take();
             let part = |c: usize| (first + count * c / n) as u32;
             chunks
                 .par_iter_mut()
@@ -230,7 +236,7 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
                 .with_max_len(1)
                 .map(|(b, (mut color, mut depth))| {
                     // SAFETY: the caller's guarantee.
-                    unsafe { T::walk(&job, chunks, b, &mut color, &mut depth) }
+                    unsafe { T::walk(&job, chunks, b, &mut color, &mut depth, clear) }
                 })
                 .reduce(DrawStats::default, |mut a, b| {
                     a += b;
@@ -329,7 +335,14 @@ pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
     band: usize,
     color: &mut C,
     depth: &mut DepthRows<'_>,
+    clear: Option<Vec3>,
 ) -> DrawStats {
+    if let Some(background) = clear {
+        // The frame's deferred clear, a band at a time: its lines are then in this
+        // core's cache when the walk writes them.
+        let len = color.len();
+        color.reset(len, background);
+    }
     let y0 = band as u32 * job.band_rows;
     let y1 = (y0 + job.band_rows).min(job.target.height) - 1;
     let mut walker =

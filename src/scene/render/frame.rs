@@ -195,7 +195,7 @@ impl SceneFrame {
             &mut self.color
         };
         self.renderer
-            .begin_frame_with(fine, color, scene.background, plan.depth_buffer);
+            .begin_frame_deferred(fine, color, scene.background, plan.depth_buffer);
         let mut stats = DrawStats::default();
         let mut vertex = Duration::ZERO;
         for ((obj, op), pipe) in scene
@@ -209,6 +209,7 @@ impl SceneFrame {
             stats += self.renderer.stats;
             self.renderer.stats = DrawStats::default();
         }
+        self.renderer.finish_clear(color);
         self.wire = WireCount::default();
         for ((obj, op), pipe) in scene.objects.iter().zip(&plan.objects).zip(&self.pipelines) {
             if op.wireframe {

@@ -246,7 +246,10 @@ impl DepthBuffer {
         &mut self,
         band: u32,
     ) -> impl IndexedParallelIterator<Item = DepthRows<'_>> + '_ {
-        assert!(band > 0 && band % TILE_H == 0, "bands of {band} rows");
+        assert!(
+            band > 0 && band.is_multiple_of(TILE_H),
+            "bands of {band} rows"
+        );
         let (width, height, words) = (self.width, self.height, self.words);
         let rows = move |i: usize| {
             let y0 = i as u32 * band;

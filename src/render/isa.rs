@@ -258,7 +258,7 @@ pub(super) mod baseline {
             band: usize,
             color: &mut C,
             depth: &mut DepthRows<'_>,
-        clear: Option<Vec3>,
+            clear: Option<Vec3>,
         ) -> DrawStats {
             tiles::walk_band::<V, S, C, wide::i32x8>(job, chunks, band, color, depth, clear)
         }
@@ -309,7 +309,7 @@ pub(super) mod avx2 {
             band: usize,
             color: &mut C,
             depth: &mut DepthRows<'_>,
-        clear: Option<Vec3>,
+            clear: Option<Vec3>,
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
             unsafe { walk::<V, S, C>(job, chunks, band, color, depth, clear) }
@@ -338,7 +338,9 @@ pub(super) mod avx2 {
         depth: &mut DepthRows<'_>,
         clear: Option<Vec3>,
     ) -> DrawStats {
-        tiles::walk_band::<V, S, C, crate::simd::avx2::I32x8>(job, chunks, band, color, depth, clear)
+        tiles::walk_band::<V, S, C, crate::simd::avx2::I32x8>(
+            job, chunks, band, color, depth, clear,
+        )
     }
 
     /// The draw loop of variant `V` compiled with AVX2 and FMA enabled and on
@@ -394,7 +396,7 @@ pub(super) mod avx512 {
             band: usize,
             color: &mut C,
             depth: &mut DepthRows<'_>,
-        clear: Option<Vec3>,
+            clear: Option<Vec3>,
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
             unsafe { walk::<S, C>(job, chunks, band, color, depth, clear) }
@@ -423,7 +425,9 @@ pub(super) mod avx512 {
         depth: &mut DepthRows<'_>,
         clear: Option<Vec3>,
     ) -> DrawStats {
-        tiles::walk_band::<Fast, S, C, crate::simd::avx512::I32x16>(job, chunks, band, color, depth, clear)
+        tiles::walk_band::<Fast, S, C, crate::simd::avx512::I32x16>(
+            job, chunks, band, color, depth, clear,
+        )
     }
 
     /// [`super::avx2::draw`]'s loop on 16 AVX-512 lanes in two-row groups (see

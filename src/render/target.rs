@@ -16,6 +16,10 @@ pub trait ColorTarget: Send {
     fn reset(&mut self, len: usize, c: Vec3);
     /// Pixels held.
     fn len(&self) -> usize;
+    /// Whether the target holds no pixel.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 
     /// Writes colour lane `k` (red, green, blue lanes) of a group for each set bit `k`
     /// of `mask`: to pixel `start + (k / 8)·stride + k % 8` (8 lanes per row, `F::ROWS`

@@ -10,6 +10,7 @@
 //! | `fragments` | the coverage sink that tests depth and shades |
 //! | [`probe`](mod@probe) | one pixel's raster state, recomputed on demand |
 //! | `isa` | the compiled copies of the draw loop and the one choice among them |
+//! | `tiles` | drawing on several threads: set-up binned by bands of rows, each band walked in draw order |
 //! | this file | [`Renderer`]: frame state and the triangle loop |
 //!
 //! Screen mapping ([`ndc_to_screen`]): NDC x ∈ [−1, 1] maps to pixels [0, width] left
@@ -116,13 +117,6 @@ impl Renderer {
     /// threads, built here once (see `tiles`), with the frame and counters one thread
     /// gives. If the pool cannot be built, draws stay on one thread.
     pub fn set_threads(&mut self, threads: usize) {
-        // Measurement only: the band height.
-        if let Some(b) = std::env::var("TERMRAST_BAND_ROWS")
-            .ok()
-            .and_then(|v| v.parse().ok())
-        {
-            self.band_rows = b;
-        }
         if threads == self.threads() {
             return;
         }

@@ -48,7 +48,7 @@ use crate::simd::I32s;
 
 /// Rows per band: a multiple of the block traversal's 8 and of the depth clear tile.
 /// Chosen by measurement (see `docs/performance.md`).
-pub const BAND_ROWS: u32 = 32;
+pub const BAND_ROWS: u32 = 48;
 
 /// Triangles per chunk of a batch (see [`draw`]): a batch's records stay a few
 /// megabytes however large the mesh.

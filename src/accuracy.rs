@@ -27,6 +27,7 @@ pub mod workloads;
 use std::time::Duration;
 
 use glam::{Mat4, Vec2, Vec3};
+use rayon::prelude::*;
 
 use self::area::{SAMPLE_COUNTS, Supersampled, aa_name, pixel_areas, snapped, supersample};
 use self::depth::{DepthFormat, DepthPass};
@@ -385,6 +386,40 @@ impl ColorTarget for UvTarget {
     fn reset(&mut self, len: usize, _: Vec3) {
         self.0.clear();
         self.0.resize(len, [f32::NAN; 2]);
+    }
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    type Rows<'a> = UvRows<'a>;
+
+    fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = UvRows<'_>> {
+        self.0.par_chunks_mut(pixels).map(UvRows)
+    }
+}
+
+/// A band of rows of a [`UvTarget`].
+struct UvRows<'a>(&'a mut [[f32; 2]]);
+
+impl ColorTarget for UvRows<'_> {
+    #[inline(always)]
+    fn put(&mut self, i: usize, c: Vec3) {
+        self.0[i] = [c.x, c.y];
+    }
+    fn reset(&mut self, _: usize, _: Vec3) {
+        self.0.fill([f32::NAN; 2]);
+    }
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    type Rows<'a>
+        = UvRows<'a>
+    where
+        Self: 'a;
+
+    fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = UvRows<'_>> {
+        self.0.par_chunks_mut(pixels).map(UvRows)
     }
 }
 

@@ -146,6 +146,21 @@ pub fn parse_size(s: &str) -> Result<Target, String> {
     Ok(Target::new(w, h))
 }
 
+/// `--threads`: a count of drawing threads, 1 to 256.
+pub fn parse_threads(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n @ 1..=256) => Ok(n),
+        Ok(n) => Err(format!("{n} threads: give 1 to 256")),
+        Err(_) => Err(format!("`{s}` is not a whole number of threads")),
+    }
+}
+
+/// The drawing threads `--threads` asks for: the machine's cores when not given.
+#[must_use]
+pub fn threads_or_cores(threads: Option<usize>) -> usize {
+    threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from))
+}
+
 /// Parses an instruction set name, refusing one the running CPU lacks (it would
 /// silently fall back to the baseline, and a benchmark would measure the wrong code).
 pub fn parse_isa(s: &str) -> Result<crate::render::Isa, String> {

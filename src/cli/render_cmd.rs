@@ -40,6 +40,10 @@ pub struct SceneArgs {
     /// file's effects say).
     #[arg(long, value_enum, default_value_t = Mode::Fill)]
     pub mode: Mode,
+    /// Drawing threads (default: the machine's cores). 1 draws on this thread alone;
+    /// every count gives the same image, bit for bit.
+    #[arg(long, value_parser = super::parse_threads)]
+    pub threads: Option<usize>,
 }
 
 impl SceneArgs {
@@ -55,6 +59,9 @@ impl SceneArgs {
         let mut frame = SceneFrame::new(scene);
         frame.interpolation = self.interpolation;
         frame.traversal = self.traversal;
+        frame
+            .renderer
+            .set_threads(super::threads_or_cores(self.threads));
         frame
     }
 }
@@ -106,22 +113,10 @@ pub struct BenchRenderArgs {
     /// Frames to render (each turns the model by 0.05 rad).
     #[arg(long, default_value_t = 100)]
     pub frames: u32,
-    /// Rendering threads: only 1 is accepted (the renderer is single-threaded).
-    #[arg(long, default_value_t = 1, value_parser = parse_threads)]
-    pub threads: u32,
     /// The draw loop's instruction set: baseline, avx2 or avx512 (default: the best
     /// this CPU has). All give identical images.
     #[arg(long, value_parser = super::parse_isa)]
     pub isa: Option<Isa>,
-}
-
-/// `--threads`: the renderer is single-threaded, so only 1 is meaningful.
-fn parse_threads(s: &str) -> Result<u32, String> {
-    match s.trim().parse::<u32>() {
-        Ok(1) => Ok(1),
-        Ok(_) => Err("the renderer is single-threaded: only 1 is accepted".into()),
-        Err(_) => Err(format!("`{s}` is not a whole number (only 1 is accepted)")),
-    }
 }
 
 /// Refuses an `--out` path that is not a PNG, before anything is rendered or created
@@ -259,6 +254,8 @@ pub struct BenchReport {
     pub covered_px: u64,
     /// The instruction set the draw loop ran on (see [`crate::render::DrawCopy::choose`]).
     pub isa: Isa,
+    /// The threads it drew on.
+    pub threads: usize,
 }
 
 impl std::fmt::Display for BenchReport {
@@ -266,13 +263,15 @@ impl std::fmt::Display for BenchReport {
         let mpx = self.covered_px as f64 / (self.median_ms * 1e3);
         write!(
             f,
-            "median_ms={:.3} min_ms={:.3} triangles={} covered_px={} mpx_per_s={:.1} isa={}",
+            "median_ms={:.3} min_ms={:.3} triangles={} covered_px={} mpx_per_s={:.1} isa={} \
+             threads={}",
             self.median_ms,
             self.min_ms,
             self.triangles,
             self.covered_px,
             mpx,
-            self.isa.name()
+            self.isa.name(),
+            self.threads
         )
     }
 }
@@ -317,5 +316,6 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
         triangles: scene.objects[0].mesh.triangle_count(),
         covered_px: covered / u64::from(frames),
         isa: frame.renderer.copy_for::<Lambert<'_>>(&opts).isa,
+        threads: frame.renderer.threads(),
     })
 }

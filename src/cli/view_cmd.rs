@@ -117,6 +117,9 @@ pub struct ViewArgs {
     /// Send frames without waiting for the terminal's answers.
     #[arg(long)]
     pub no_pacing: bool,
+    /// Drawing threads (default: the machine's cores); 1 draws on the viewer's thread.
+    #[arg(long, value_parser = super::parse_threads)]
+    pub threads: Option<usize>,
 }
 
 /// A scene file (`SCENE.toml`), or a model's default scene drawn in `mode`, culled
@@ -162,6 +165,10 @@ pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
     let scene = load(&args.model, args.mode, args.cull)?;
     let warned = scene.warnings.len();
     let mut app = App::new(scene, args.look.settings());
+    app.scene
+        .frame
+        .renderer
+        .set_threads(super::threads_or_cores(args.threads));
     app.notice = args.look.notice_in(env).or_else(|| {
         (warned > 0).then(|| {
             format!(

@@ -11,6 +11,9 @@
 //! affine in screen space (exact to interpolate with screen-space barycentrics, no
 //! divide), and compares with `<`.
 
+use rayon::iter::Either;
+use rayon::prelude::*;
+
 /// When a fragment passes the depth test.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
 pub enum DepthFunc {
@@ -216,13 +219,155 @@ impl DepthBuffer {
 
     /// Fills the stale tiles overlapping pixels `x0..=x1` × `y0..=y1` with
     /// [`DEPTH_CLEAR`]. Costs a word test per tile row when none is stale: the
-    /// renderer calls this once per triangle, so a box within one bit word
-    /// (every box narrower than 64 tiles that does not cross a word's edge) takes a
-    /// loop of its own, with the span computed once.
+    /// renderer calls this once per triangle (see [`DepthRows::fill_stale`]).
     #[inline(always)]
     pub fn fill_stale(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+        self.all_rows().fill_stale(x0, y0, x1, y1);
+    }
+
+    /// Every row as one [`DepthRows`].
+    #[inline(always)]
+    fn all_rows(&mut self) -> DepthRows<'_> {
+        DepthRows {
+            data: &mut self.data,
+            stale: &mut self.stale,
+            words: self.words,
+            width: self.width,
+            y0: 0,
+            rows: self.height,
+        }
+    }
+
+    /// The buffer in bands of `band` rows (a multiple of [`TILE_H`], so no clear tile
+    /// is shared by two bands), top to bottom: disjoint borrows that threads can fill
+    /// and write at once. A buffer without storage gives bands without values, for
+    /// draws that do not use depth.
+    pub(crate) fn bands(
+        &mut self,
+        band: u32,
+    ) -> impl IndexedParallelIterator<Item = DepthRows<'_>> + '_ {
+        assert!(
+            band > 0 && band.is_multiple_of(TILE_H),
+            "bands of {band} rows"
+        );
+        let (width, height, words) = (self.width, self.height, self.words);
+        let rows = move |i: usize| {
+            let y0 = i as u32 * band;
+            (y0, band.min(height - y0))
+        };
+        if self.has_storage() && width > 0 {
+            let px = band as usize * width as usize;
+            let bits = (band / TILE_H) as usize * words;
+            Either::Left(
+                self.data
+                    .par_chunks_mut(px)
+                    .zip(self.stale.par_chunks_mut(bits))
+                    .enumerate()
+                    .map(move |(i, (data, stale))| {
+                        let (y0, rows) = rows(i);
+                        DepthRows {
+                            data,
+                            stale,
+                            words,
+                            width,
+                            y0,
+                            rows,
+                        }
+                    }),
+            )
+        } else {
+            Either::Right(
+                (0..height.div_ceil(band) as usize)
+                    .into_par_iter()
+                    .map(move |i| {
+                        let (y0, rows) = rows(i);
+                        DepthRows {
+                            data: &mut [],
+                            stale: &mut [],
+                            words: 0,
+                            width,
+                            y0,
+                            rows,
+                        }
+                    }),
+            )
+        }
+    }
+
+    /// The values, row-major, for writers that filled the stale tiles they touch first.
+    #[inline(always)]
+    pub(crate) fn filled_mut(&mut self) -> &mut [f32] {
+        &mut self.data
+    }
+}
+
+/// Where the fragment stage tests and writes depth: the whole [`DepthBuffer`], or one
+/// band of its rows ([`DepthRows`]) that a thread owns while others draw the rest.
+pub(crate) trait DepthStore {
+    /// The frame's row-major index of the first value [`DepthStore::filled_mut`] holds.
+    fn base(&self) -> usize;
+    /// [`DepthBuffer::fill_stale`], for pixels in these rows.
+    fn fill_stale(&mut self, x0: u32, y0: u32, x1: u32, y1: u32);
+    /// [`DepthBuffer::filled_mut`] of these rows.
+    fn filled_mut(&mut self) -> &mut [f32];
+}
+
+impl DepthStore for DepthBuffer {
+    #[inline(always)]
+    fn base(&self) -> usize {
+        0
+    }
+    #[inline(always)]
+    fn fill_stale(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+        DepthBuffer::fill_stale(self, x0, y0, x1, y1);
+    }
+    #[inline(always)]
+    fn filled_mut(&mut self) -> &mut [f32] {
+        DepthBuffer::filled_mut(self)
+    }
+}
+
+/// Rows `y0..y0 + rows` of a [`DepthBuffer`] (`y0` a multiple of [`TILE_H`]): their
+/// values and their tiles' stale bits.
+#[derive(Debug)]
+pub(crate) struct DepthRows<'a> {
+    data: &'a mut [f32],
+    /// From the bit word of tile row `y0 / TILE_H`.
+    stale: &'a mut [u64],
+    words: usize,
+    width: u32,
+    y0: u32,
+    rows: u32,
+}
+
+impl DepthStore for DepthRows<'_> {
+    #[inline(always)]
+    fn base(&self) -> usize {
+        self.y0 as usize * self.width as usize
+    }
+    #[inline(always)]
+    fn fill_stale(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+        DepthRows::fill_stale(self, x0, y0, x1, y1);
+    }
+    #[inline(always)]
+    fn filled_mut(&mut self) -> &mut [f32] {
+        &mut *self.data
+    }
+}
+
+impl DepthRows<'_> {
+    /// Fills the stale tiles overlapping pixels `x0..=x1` × `y0..=y1` (rows of this
+    /// band) with [`DEPTH_CLEAR`]. A box within one bit word (every box narrower than
+    /// 64 tiles that does not cross a word's edge) takes a loop of its own, with the
+    /// span computed once.
+    #[inline(always)]
+    fn fill_stale(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+        debug_assert!(y0 >= self.y0 && y1 < self.y0 + self.rows, "{y0}..={y1}");
         let (tx0, tx1) = ((x0 / TILE_W) as usize, (x1 / TILE_W) as usize);
-        let (ty0, ty1) = ((y0 / TILE_H) as usize, (y1 / TILE_H) as usize);
+        let (ty0, ty1) = (
+            ((y0 - self.y0) / TILE_H) as usize,
+            ((y1 - self.y0) / TILE_H) as usize,
+        );
         let (w0, w1) = (tx0 / 64, tx1 / 64);
         if w0 == w1 {
             let span = word_span(tx0 % 64, tx1 % 64);
@@ -240,7 +385,7 @@ impl DepthBuffer {
         }
     }
 
-    /// Fills the stale tiles of `span` in bit word `w` of tile row `ty`.
+    /// Fills the stale tiles of `span` in bit word `w` of the band's tile row `ty`.
     #[inline(always)]
     fn fill_stale_word(&mut self, ty: usize, w: usize, span: u64) {
         let word = &mut self.stale[ty * self.words + w];
@@ -251,14 +396,14 @@ impl DepthBuffer {
         }
     }
 
-    /// Fills the tiles of the set bits `m` of bit word `w` in tile row `ty`. Out of
-    /// line: it runs about once per tile per frame, against once per triangle for the
-    /// test before it.
+    /// Fills the tiles of the set bits `m` of bit word `w` in the band's tile row
+    /// `ty`. Out of line: it runs about once per tile per frame, against once per
+    /// triangle for the test before it.
     #[inline(never)]
     fn fill_tiles(&mut self, w: usize, ty: usize, mut m: u64) {
         let width = self.width as usize;
         let y0 = ty * TILE_H as usize;
-        let y1 = (y0 + TILE_H as usize).min(self.height as usize);
+        let y1 = (y0 + TILE_H as usize).min(self.rows as usize);
         while m != 0 {
             let x0 = (w * 64 + m.trailing_zeros() as usize) * TILE_W as usize;
             let x1 = (x0 + TILE_W as usize).min(width);
@@ -267,12 +412,6 @@ impl DepthBuffer {
             }
             m &= m - 1;
         }
-    }
-
-    /// The values, row-major, for writers that filled the stale tiles they touch first.
-    #[inline(always)]
-    pub(crate) fn filled_mut(&mut self) -> &mut [f32] {
-        &mut self.data
     }
 }
 

@@ -15,8 +15,9 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-/// A set of per-vertex attributes interpolated across a triangle.
-pub trait Varying: Copy {
+/// A set of per-vertex attributes interpolated across a triangle. `Send + Sync`
+/// and `'static`: a threaded draw's threads share and keep the per-triangle records.
+pub trait Varying: Copy + Send + Sync + 'static {
     /// Whether only the value's direction matters to the shader that reads it (a
     /// normal it normalises per pixel): the value times any positive factor shades
     /// the same. Under perspective such a varying is interpolated as `attribute/w`

@@ -311,6 +311,30 @@ impl Setup {
         each3!(|e| self.origin[e] >> SUBPIXEL_BITS)
     }
 
+    /// The same triangle with its box limited to rows `y0..=y1`, or `None` when the box
+    /// has no row there. The origin moves by whole rows (exact), so every traversal
+    /// gives the same edge values at each pixel as it does over the whole box: what
+    /// lets a band of rows be walked on its own.
+    #[must_use]
+    #[inline(always)]
+    pub fn rows(&self, y0: u32, y1: u32) -> Option<Setup> {
+        let b = self.bbox;
+        let (lo, hi) = (b.y0.max(y0), b.y1.min(y1));
+        if lo > hi {
+            return None;
+        }
+        let down = i64::from(lo - b.y0) * SUBPIXEL_ONE;
+        Some(Setup {
+            bbox: PixelRect {
+                y0: lo,
+                y1: hi,
+                ..b
+            },
+            origin: each3!(|e| self.origin[e] + self.j[e] * down),
+            ..*self
+        })
+    }
+
     /// Maps a barycentric triple in setup order (A, B, C after any flip) back to the
     /// caller's vertex order.
     #[must_use]

@@ -9,18 +9,20 @@ use super::prepare::{EmitPiece, Prepared};
 use super::shader::{ShadeLanes, Shader};
 use super::target::ColorTarget;
 use crate::counters::{self, Stage};
-use crate::raster::depth::{DepthBuffer, DepthFunc};
-use crate::raster::{CoverageSink, Target};
+use crate::raster::depth::{DepthFunc, DepthStore};
+use crate::raster::{CoverageSink, Setup, Target};
 use crate::simd::{F32s, I32s, each3};
 
 /// The fragment loop of one triangle: receives coverage from the traversal.
 ///
 /// The variant `V` says which options are compile-time constants (see
-/// [`DrawVariant`]); the lanes `L` are those of the copy's instruction set.
-struct Fragments<'a, S: Shader, C, L, V> {
+/// [`DrawVariant`]); the lanes `L` are those of the copy's instruction set. Depth
+/// lives in `D`: the whole buffer, or the band of rows a thread draws, whose first
+/// pixel ([`DepthStore::base`]) is index 0 of both its depth and its colour `C`.
+struct Fragments<'a, S: Shader, C, L, V, D> {
     tri: &'a Prepared<S::Varying>,
     shader: &'a S,
-    depth: &'a mut DepthBuffer,
+    depth: &'a mut D,
     color: &'a mut C,
     opts: DrawOptions,
     width: usize,
@@ -34,13 +36,13 @@ struct Fragments<'a, S: Shader, C, L, V> {
     lanes: PhantomData<(L, V)>,
 }
 
-impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> CoverageSink
-    for Fragments<'_, S, C, L, V>
+impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore> CoverageSink
+    for Fragments<'_, S, C, L, V, D>
 {
     #[inline(always)]
     fn pixel(&mut self, x: u32, y: u32) {
         let e = self.tri.eval(x, y);
-        let i = y as usize * self.width + x as usize;
+        let i = y as usize * self.width + x as usize - self.depth.base();
         self.stats.fragments += 1;
         let (depth_state, interpolation) = V::state(&self.opts);
         if depth_state.uses_buffer() {
@@ -98,7 +100,9 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> CoverageSink
     }
 }
 
-impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> Fragments<'_, S, C, L, V> {
+impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore>
+    Fragments<'_, S, C, L, V, D>
+{
     /// A group that reaches past the target (only in targets under 8 pixels wide, see
     /// [`CoverageSink::mask8`]), pixel by pixel (bit `k` is pixel `k % 8` of row
     /// `k / 8`).
@@ -141,7 +145,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> Fragments<'_, S, C, L, 
     #[inline(always)]
     fn shade_lanes<F: F32s>(&mut self, y: u32, x0: u32, mask: u32, g: [F; 3]) {
         let t = self.tri;
-        let start = y as usize * self.width + x0 as usize;
+        let start = y as usize * self.width + x0 as usize - self.depth.base();
         // Rows below the first only when the mask has lanes there: the last row of the
         // target has none below it.
         let stride = if F::ROWS > 1 && mask >> 8 != 0 {
@@ -185,10 +189,11 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> Fragments<'_, S, C, L, 
 /// The per-draw state that takes each prepared piece of a triangle ([`EmitPiece`]),
 /// fills the stale depth tiles under it and walks it into a [`Fragments`] sink.
 /// `V::WIDE_ONLY` fixes the traversal to `wide` at compile time; otherwise
-/// `opts.traversal` picks it.
-pub(super) struct PieceWalker<'a, S, C, L, V> {
+/// `opts.traversal` picks it. `D` is the whole depth buffer, or one band of its rows
+/// (with `C` the same band of the colour target).
+pub(super) struct PieceWalker<'a, S, C, L, V, D> {
     shader: &'a S,
-    depth: &'a mut DepthBuffer,
+    depth: &'a mut D,
     color: &'a mut C,
     opts: DrawOptions,
     width: usize,
@@ -197,12 +202,13 @@ pub(super) struct PieceWalker<'a, S, C, L, V> {
     lanes: PhantomData<(L, V)>,
 }
 
-impl<'a, S, C, L, V> PieceWalker<'a, S, C, L, V> {
-    /// A walker for one draw into `depth` and `color` (both sized for `target`).
+impl<'a, S, C, L, V, D> PieceWalker<'a, S, C, L, V, D> {
+    /// A walker for one draw into `depth` and `color` (both sized for `target`, or
+    /// the same band of rows of each).
     #[inline(always)]
     pub(super) fn new(
         shader: &'a S,
-        depth: &'a mut DepthBuffer,
+        depth: &'a mut D,
         color: &'a mut C,
         opts: &DrawOptions,
         target: Target,
@@ -219,19 +225,30 @@ impl<'a, S, C, L, V> PieceWalker<'a, S, C, L, V> {
     }
 }
 
-impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> EmitPiece<S::Varying>
-    for PieceWalker<'_, S, C, L, V>
+impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore> EmitPiece<S::Varying>
+    for PieceWalker<'_, S, C, L, V, D>
 {
     #[inline(always)]
     fn piece(&mut self, tri: &Prepared<S::Varying>) {
+        self.walk(tri, &tri.setup);
+    }
+}
+
+impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore>
+    PieceWalker<'_, S, C, L, V, D>
+{
+    /// Walks `setup`'s box of triangle `tri`: its own ([`EmitPiece::piece`]), or the
+    /// part in a band of rows ([`Setup::rows`], the same edge values at every pixel).
+    #[inline(always)]
+    pub(super) fn walk(&mut self, tri: &Prepared<S::Varying>, setup: &Setup) {
         let (depth_state, _) = V::state(&self.opts);
         if depth_state.uses_buffer() {
             // Groups can overhang the box into stale tiles, but only with lanes outside
             // the mask, whose depth the test writes back unchanged.
-            let b = tri.setup.bbox;
+            let b = setup.bbox;
             self.depth.fill_stale(b.x0, b.y0, b.x1, b.y1);
         }
-        let mut frag = Fragments::<S, C, L, V> {
+        let mut frag = Fragments::<S, C, L, V, D> {
             tri,
             shader: self.shader,
             depth: &mut *self.depth,
@@ -242,9 +259,9 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> EmitPiece<S::Varying>
             lanes: PhantomData,
         };
         if V::WIDE_ONLY {
-            crate::raster::traverse::wide_lanes::<L, _>(&tri.setup, &mut frag);
+            crate::raster::traverse::wide_lanes::<L, _>(setup, &mut frag);
         } else {
-            self.opts.traversal.run_lanes::<L, _>(&tri.setup, &mut frag);
+            self.opts.traversal.run_lanes::<L, _>(setup, &mut frag);
         }
     }
 }

@@ -11,6 +11,7 @@
 use super::options::DrawOptions;
 use super::shader::Shader;
 use super::target::ColorTarget;
+use super::tiles;
 use super::{Renderer, VertexCache};
 use crate::raster::Traversal;
 use crate::raster::depth::DepthState;
@@ -139,6 +140,10 @@ pub(super) fn run<S: Shader, C: ColorTarget>(
     opts: &DrawOptions,
     color: &mut C,
 ) {
+    if r.threaded() {
+        run_tiled(copy, r, shader, cache, indices, opts, color);
+        return;
+    }
     #[cfg(target_arch = "x86_64")]
     {
         // `S::LANE_CODE` first, as its own condition: a constant `false` there keeps
@@ -171,10 +176,93 @@ pub(super) fn run<S: Shader, C: ColorTarget>(
     }
 }
 
+/// [`run`] on the renderer's threads (see [`tiles`]): the same copy of the draw
+/// loop, walking bands of rows.
+#[inline(always)]
+fn run_tiled<S: Shader, C: ColorTarget>(
+    copy: DrawCopy,
+    r: &mut Renderer,
+    shader: &S,
+    cache: &VertexCache<S::Varying>,
+    indices: &[u32],
+    opts: &DrawOptions,
+    color: &mut C,
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        // SAFETY (all three): `choose` picks an instruction set only when the CPU has it.
+        if S::LANE_CODE && copy.isa == Isa::Avx512 {
+            unsafe { tiles::draw::<avx512::Tiled, _, _>(r, shader, cache, indices, opts, color) };
+            return;
+        }
+        if copy.isa != Isa::Baseline {
+            unsafe {
+                match copy.variant {
+                    Variant::Generic => tiles::draw::<avx2::Tiled<Generic>, _, _>(
+                        r, shader, cache, indices, opts, color,
+                    ),
+                    Variant::Standard | Variant::Fast => {
+                        tiles::draw::<avx2::Tiled<Standard>, _, _>(
+                            r, shader, cache, indices, opts, color,
+                        )
+                    }
+                }
+            }
+            return;
+        }
+    }
+    // SAFETY: the baseline copy runs on every CPU.
+    unsafe {
+        match copy.variant {
+            Variant::Generic => {
+                tiles::draw::<baseline::Tiled<Generic>, _, _>(
+                    r, shader, cache, indices, opts, color,
+                );
+            }
+            Variant::Standard | Variant::Fast => {
+                tiles::draw::<baseline::Tiled<Standard>, _, _>(
+                    r, shader, cache, indices, opts, color,
+                );
+            }
+        }
+    }
+}
+
 /// The baseline copy: the build's own target, for CPUs without AVX2.
 pub(super) mod baseline {
+    use std::marker::PhantomData;
+    use std::ops::Range;
+
     use super::DrawVariant;
+    use glam::Vec3;
+
+    use crate::raster::depth::DepthRows;
+    use crate::render::options::DrawStats;
+    use crate::render::tiles::{self, Chunk, Job, TileCopy};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
+
+    /// The threaded draw's steps of variant `V` on [`wide`]'s portable lanes.
+    pub(in crate::render) struct Tiled<V>(PhantomData<V>);
+
+    impl<V: DrawVariant> TileCopy for Tiled<V> {
+        unsafe fn setup<S: Shader>(
+            job: &Job<'_, S>,
+            range: Range<u32>,
+            chunk: &mut Chunk<S::Varying>,
+        ) {
+            tiles::setup_chunk(job, range, chunk);
+        }
+        unsafe fn walk<S: Shader, C: ColorTarget>(
+            job: &Job<'_, S>,
+            chunks: &[Chunk<S::Varying>],
+            band: usize,
+            color: &mut C,
+            depth: &mut DepthRows<'_>,
+            clear: Option<Vec3>,
+        ) -> DrawStats {
+            tiles::walk_band::<V, S, C, wide::i32x8>(job, chunks, band, color, depth, clear)
+        }
+    }
 
     /// The draw loop of variant `V` on [`wide`]'s portable lanes.
     pub(in crate::render) fn draw<V: DrawVariant, S: Shader, C: ColorTarget>(
@@ -192,8 +280,68 @@ pub(super) mod baseline {
 /// The AVX2 copy.
 #[cfg(target_arch = "x86_64")]
 pub(super) mod avx2 {
+    use std::marker::PhantomData;
+    use std::ops::Range;
+
     use super::DrawVariant;
+    use glam::Vec3;
+
+    use crate::raster::depth::DepthRows;
+    use crate::render::options::DrawStats;
+    use crate::render::tiles::{self, Chunk, Job, TileCopy};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
+
+    /// The threaded draw's steps of variant `V`, compiled as [`draw`] is.
+    pub(in crate::render) struct Tiled<V>(PhantomData<V>);
+
+    impl<V: DrawVariant> TileCopy for Tiled<V> {
+        unsafe fn setup<S: Shader>(
+            job: &Job<'_, S>,
+            range: Range<u32>,
+            chunk: &mut Chunk<S::Varying>,
+        ) {
+            // SAFETY: the caller's guarantee.
+            unsafe { setup(job, range, chunk) };
+        }
+        unsafe fn walk<S: Shader, C: ColorTarget>(
+            job: &Job<'_, S>,
+            chunks: &[Chunk<S::Varying>],
+            band: usize,
+            color: &mut C,
+            depth: &mut DepthRows<'_>,
+            clear: Option<Vec3>,
+        ) -> DrawStats {
+            // SAFETY: the caller's guarantee.
+            unsafe { walk::<V, S, C>(job, chunks, band, color, depth, clear) }
+        }
+    }
+
+    /// [`tiles::setup_chunk`] compiled with AVX2.
+    ///
+    /// # Safety
+    /// As for [`draw`].
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1")]
+    unsafe fn setup<S: Shader>(job: &Job<'_, S>, range: Range<u32>, chunk: &mut Chunk<S::Varying>) {
+        tiles::setup_chunk(job, range, chunk);
+    }
+
+    /// [`tiles::walk_band`] on the AVX2 lanes.
+    ///
+    /// # Safety
+    /// As for [`draw`].
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1")]
+    unsafe fn walk<V: DrawVariant, S: Shader, C: ColorTarget>(
+        job: &Job<'_, S>,
+        chunks: &[Chunk<S::Varying>],
+        band: usize,
+        color: &mut C,
+        depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
+    ) -> DrawStats {
+        tiles::walk_band::<V, S, C, crate::simd::avx2::I32x8>(
+            job, chunks, band, color, depth, clear,
+        )
+    }
 
     /// The draw loop of variant `V` compiled with AVX2 and FMA enabled and on
     /// [`crate::simd`]'s AVX2 lanes, so 8-lane values are one 256-bit register instead
@@ -220,8 +368,67 @@ pub(super) mod avx2 {
 /// The AVX-512 copy, of the [`super::Fast`] variant only.
 #[cfg(target_arch = "x86_64")]
 pub(super) mod avx512 {
+    use std::ops::Range;
+
     use super::Fast;
+    use glam::Vec3;
+
+    use crate::raster::depth::DepthRows;
+    use crate::render::options::DrawStats;
+    use crate::render::tiles::{self, Chunk, Job, TileCopy};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
+
+    /// The threaded draw's steps, compiled as [`draw`] is.
+    pub(in crate::render) struct Tiled;
+
+    impl TileCopy for Tiled {
+        unsafe fn setup<S: Shader>(
+            job: &Job<'_, S>,
+            range: Range<u32>,
+            chunk: &mut Chunk<S::Varying>,
+        ) {
+            // SAFETY: the caller's guarantee.
+            unsafe { setup(job, range, chunk) };
+        }
+        unsafe fn walk<S: Shader, C: ColorTarget>(
+            job: &Job<'_, S>,
+            chunks: &[Chunk<S::Varying>],
+            band: usize,
+            color: &mut C,
+            depth: &mut DepthRows<'_>,
+            clear: Option<Vec3>,
+        ) -> DrawStats {
+            // SAFETY: the caller's guarantee.
+            unsafe { walk::<S, C>(job, chunks, band, color, depth, clear) }
+        }
+    }
+
+    /// [`tiles::setup_chunk`] compiled with AVX-512.
+    ///
+    /// # Safety
+    /// As for [`draw`].
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,avx512f,avx512vl,avx512bw,avx512dq")]
+    unsafe fn setup<S: Shader>(job: &Job<'_, S>, range: Range<u32>, chunk: &mut Chunk<S::Varying>) {
+        tiles::setup_chunk(job, range, chunk);
+    }
+
+    /// [`tiles::walk_band`] on 16 AVX-512 lanes in two-row groups.
+    ///
+    /// # Safety
+    /// As for [`draw`].
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,avx512f,avx512vl,avx512bw,avx512dq")]
+    unsafe fn walk<S: Shader, C: ColorTarget>(
+        job: &Job<'_, S>,
+        chunks: &[Chunk<S::Varying>],
+        band: usize,
+        color: &mut C,
+        depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
+    ) -> DrawStats {
+        tiles::walk_band::<Fast, S, C, crate::simd::avx512::I32x16>(
+            job, chunks, band, color, depth, clear,
+        )
+    }
 
     /// [`super::avx2::draw`]'s loop on 16 AVX-512 lanes in two-row groups (see
     /// [`super::Isa::Avx512`]): the same operations per lane, so the same bits.

@@ -10,6 +10,7 @@
 //! | `fragments` | the coverage sink that tests depth and shades |
 //! | [`probe`](mod@probe) | one pixel's raster state, recomputed on demand |
 //! | `isa` | the compiled copies of the draw loop and the one choice among them |
+//! | `tiles` | drawing on several threads: set-up binned by bands of rows, each band walked in draw order |
 //! | this file | [`Renderer`]: frame state and the triangle loop |
 //!
 //! Screen mapping ([`ndc_to_screen`]): NDC x ∈ [−1, 1] maps to pixels [0, width] left
@@ -50,7 +51,10 @@ pub mod probe;
 pub mod shader;
 pub mod shaders;
 pub mod target;
+mod tiles;
 pub mod wire;
+
+use std::sync::Arc;
 
 use glam::Vec3;
 
@@ -67,7 +71,8 @@ pub use prepare::{
     prepare_projected, project_vertices, transform,
 };
 pub use shader::{ShadeLanes, Shader};
-pub use target::{ColorTarget, Rgba8};
+pub use target::{ColorTarget, Rgba8, Rgba8Rows};
+pub use tiles::BAND_ROWS;
 
 /// Owns the depth buffer and frame counters; draws meshes into a colour target.
 #[derive(Debug)]
@@ -79,7 +84,32 @@ pub struct Renderer {
     pub isa: Isa,
     /// The current draw's vertex projections, reused between draws.
     projected: Vec<Projected>,
+    /// The threads draws run on ([`Renderer::set_threads`]); none for one thread.
+    pool: Option<Arc<rayon::ThreadPool>>,
+    /// The threaded draws' set-up records and bins, reused between draws.
+    scratch: tiles::Scratch,
+    /// Rows per band of a threaded draw.
+    band_rows: u32,
+    /// The background of a colour clear left to the frame's first threaded draw
+    /// ([`Renderer::begin_frame_deferred`]).
+    pending_clear: Option<Vec3>,
+    /// The least work (pixels + [`TRIANGLE_WORK`] × triangles) a draw must have to
+    /// run on several threads: below it, handing the draw out costs more than the
+    /// second thread saves (a model at terminal size). Tests set 0.
+    pub min_threaded_work: u64,
+    /// Whether the current draw runs on several threads.
+    threaded: bool,
+    /// Whether this frame may use the pool at all ([`Renderer::plan_frame`]).
+    frame_threads: bool,
 }
+
+/// Pixels a triangle's share of a draw is worth, for [`Renderer::min_threaded_work`]:
+/// set-up and binning, which many small triangles make the larger part.
+pub const TRIANGLE_WORK: u64 = 32;
+
+/// The default [`Renderer::min_threaded_work`]: a megapixel, or some 32 000
+/// triangles.
+pub const MIN_THREADED_WORK: u64 = 1 << 20;
 
 impl Renderer {
     /// A renderer for a target size.
@@ -91,7 +121,82 @@ impl Renderer {
             stats: DrawStats::default(),
             isa: Isa::detect(),
             projected: Vec::new(),
+            pool: None,
+            scratch: tiles::Scratch::default(),
+            band_rows: BAND_ROWS,
+            pending_clear: None,
+            min_threaded_work: MIN_THREADED_WORK,
+            threaded: false,
+            frame_threads: true,
         }
+    }
+
+    /// Draws on `threads` threads from now on (at least 1). One thread is the
+    /// single-threaded path itself; more run every draw on a pool of that many
+    /// threads, built here once (see `tiles`), with the frame and counters one thread
+    /// gives. If the pool cannot be built, draws stay on one thread.
+    pub fn set_threads(&mut self, threads: usize) {
+        if threads == self.threads() {
+            return;
+        }
+        self.pool = (threads > 1)
+            .then(|| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .thread_name(|i| format!("termrast-draw-{i}"))
+                    .build()
+                    .ok()
+                    .map(Arc::new)
+            })
+            .flatten();
+    }
+
+    /// The threads draws run on.
+    #[must_use]
+    pub fn threads(&self) -> usize {
+        self.pool.as_ref().map_or(1, |p| p.current_num_threads())
+    }
+
+    /// Says how much work the coming frame has in all (pixels + [`TRIANGLE_WORK`] ×
+    /// triangles): a frame below [`Renderer::min_threaded_work`] runs wholly on the
+    /// calling thread, vertices and clears included, as if there were no pool.
+    pub fn plan_frame(&mut self, work: u64) {
+        self.frame_threads = work >= self.min_threaded_work;
+    }
+
+    /// The pool this frame's work runs on, if more than one thread and the frame is
+    /// worth it: a caller that runs a whole frame inside it (`install`) hands the
+    /// frame to its threads once, instead of once per step.
+    #[must_use]
+    pub fn pool(&self) -> Option<&Arc<rayon::ThreadPool>> {
+        self.pool.as_ref().filter(|_| self.frame_threads)
+    }
+
+    /// [`transform`] on the renderer's threads: the same vertices, in chunks of
+    /// the vertex array.
+    pub fn transform<S: Shader>(
+        &self,
+        shader: &S,
+        vertex_count: usize,
+        cache: &mut VertexCache<S::Varying>,
+    ) {
+        let Some(pool) = self.pool() else {
+            transform(shader, vertex_count, cache);
+            return;
+        };
+        pool.install(|| {
+            use rayon::prelude::*;
+            cache.verts.clear();
+            cache.verts.par_extend(
+                (0..vertex_count as u32)
+                    .into_par_iter()
+                    .with_min_len(tiles::VERTEX_JOB)
+                    .map(|i| {
+                        let (pos, var) = shader.vertex(i);
+                        crate::raster::clip::ClipVertex { pos, var }
+                    }),
+            );
+        });
     }
 
     /// Starts a frame: clears depth and colour (reallocating only on resize) and the
@@ -110,6 +215,22 @@ impl Renderer {
         background: Vec3,
         depth: bool,
     ) {
+        self.begin_frame_deferred(target, color, background, depth);
+        self.finish_clear(color);
+    }
+
+    /// [`Renderer::begin_frame_with`], but on several threads the colour clear is left
+    /// to the frame's first draw, whose threads clear each band just before they walk
+    /// it (one pass over the frame fewer). The caller must call
+    /// [`Renderer::finish_clear`] before it touches the colour target other than by
+    /// [`Renderer::draw`].
+    pub fn begin_frame_deferred<C: ColorTarget>(
+        &mut self,
+        target: Target,
+        color: &mut C,
+        background: Vec3,
+        depth: bool,
+    ) {
         self.target = target;
         if depth {
             self.depth.reset(target.width, target.height);
@@ -117,8 +238,40 @@ impl Renderer {
         } else {
             self.depth = DepthBuffer::empty(target.width, target.height);
         }
-        color.reset(target.len(), background);
+        self.pending_clear = None;
+        if self.tiled() && color.len() == target.len() {
+            self.pending_clear = Some(background);
+        } else {
+            color.reset(target.len(), background);
+        }
         self.stats = DrawStats::default();
+    }
+
+    /// Clears the colour target if a deferred clear is still pending (no draw of the
+    /// frame took it), on the renderer's threads.
+    pub fn finish_clear<C: ColorTarget>(&mut self, color: &mut C) {
+        let (Some(background), Some(pool)) = (self.pending_clear.take(), self.pool()) else {
+            return;
+        };
+        use rayon::prelude::*;
+        let band = self.band_rows as usize * self.target.width as usize;
+        pool.install(|| {
+            color.bands(band).for_each(|mut b| {
+                let len = b.len();
+                b.reset(len, background);
+            });
+        });
+    }
+
+    /// Whether draws run on several threads ([`tiles`]): with a pool, on a target
+    /// with pixels.
+    fn tiled(&self) -> bool {
+        self.pool().is_some() && !self.target.is_empty()
+    }
+
+    /// Whether the current draw runs on several threads (set by [`Renderer::draw`]).
+    pub(super) fn threaded(&self) -> bool {
+        self.threaded
     }
 
     /// Whether this frame has a depth buffer.
@@ -139,6 +292,11 @@ impl Renderer {
     ) {
         if opts.depth.uses_buffer() && !self.has_depth() {
             self.depth.reset(self.target.width, self.target.height);
+        }
+        let work = self.target.len() as u64 + TRIANGLE_WORK * (indices.len() / 3) as u64;
+        self.threaded = self.tiled() && work >= self.min_threaded_work;
+        if !self.threaded {
+            self.finish_clear(color);
         }
         let copy = self.copy_for::<S>(opts);
         isa::run(copy, self, shader, cache, indices, opts, color);
@@ -167,7 +325,7 @@ impl Renderer {
         let mut projected = std::mem::take(&mut self.projected);
         project_vertices(cache, target, &mut projected);
         let mut walker =
-            PieceWalker::<S, C, L, V>::new(shader, &mut self.depth, color, opts, target);
+            PieceWalker::<S, C, L, V, _>::new(shader, &mut self.depth, color, opts, target);
         let n = (indices.len() / 3) as u32;
         for t in 0..n {
             walker.stats.triangles += 1;

@@ -9,7 +9,9 @@ use crate::simd::{F32s, each3};
 /// A shader: the vertex stage produces clip-space positions and varyings for vertex
 /// indices, the fragment stage a linear RGB colour from interpolated varyings. The
 /// varying type is fixed at compile time, so each shader gets its own pipeline.
-pub trait Shader {
+///
+/// `Sync`: a threaded draw's threads share the shader.
+pub trait Shader: Sync {
     type Varying: Varying;
     /// Clip-space position and varyings of vertex `index`.
     fn vertex(&self, index: u32) -> (Vec4, Self::Varying);

@@ -1,16 +1,25 @@
 //! Colour targets: what fragments are written into.
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use crate::simd::{F32s, I32s, each3};
 
 /// A framebuffer a draw writes shaded fragments into. Generic so the write is
 /// inlined into the fragment loop.
-pub trait ColorTarget {
+///
+/// `Send`: a threaded draw hands the target's bands to its threads.
+pub trait ColorTarget: Send {
     /// Writes the linear RGB colour (components in 0..1) of pixel `index` (row-major).
     fn put(&mut self, index: usize, c: Vec3);
     /// Fills the whole target, resizing to `len` pixels only if needed.
     fn reset(&mut self, len: usize, c: Vec3);
+    /// Pixels held.
+    fn len(&self) -> usize;
+    /// Whether the target holds no pixel.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 
     /// Writes colour lane `k` (red, green, blue lanes) of a group for each set bit `k`
     /// of `mask`: to pixel `start + (k / 8)·stride + k % 8` (8 lanes per row, `F::ROWS`
@@ -34,6 +43,16 @@ pub trait ColorTarget {
     fn put_lanes_grey<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, g: F) {
         self.put_lanes(start, stride, mask, &[g, g, g]);
     }
+
+    /// A band of whole rows of the target, indexed from the band's first pixel: what
+    /// one thread of a threaded draw writes while the others write the other bands.
+    type Rows<'a>: ColorTarget + Send
+    where
+        Self: 'a;
+
+    /// The target in bands of `pixels` pixels each (the last may be shorter), first
+    /// to last: disjoint borrows, so threads can write them at once.
+    fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = Self::Rows<'_>>;
 }
 
 /// 8-bit RGBA. Alpha records coverage: the background is cleared with alpha 0 and
@@ -60,50 +79,129 @@ pub fn to_u8_lanes<F: F32s>(v: F) -> F::I {
     (v * F::splat(255.0) + F::splat(0.5)).trunc_i32()
 }
 
-impl Rgba8 {
-    /// Stores packed RGBA words `px` into the group's pixels where `mask` is set (see
-    /// [`ColorTarget::put_lanes`]), one blended or masked store per row.
-    #[inline(always)]
-    fn blend_lanes<I: I32s>(&mut self, start: usize, stride: usize, mask: u32, px: I) {
-        px.store_rows(bytemuck::cast_slice_mut(&mut self.0), start, stride, mask);
+/// Stores packed RGBA words `px` into the group's pixels of `out` where `mask` is set
+/// (see [`ColorTarget::put_lanes`]), one blended or masked store per row.
+#[inline(always)]
+fn blend_lanes<I: I32s>(out: &mut [[u8; 4]], start: usize, stride: usize, mask: u32, px: I) {
+    px.store_rows(bytemuck::cast_slice_mut(out), start, stride, mask);
+}
+
+/// The cleared pixel of background `c`: alpha 0, nothing covered.
+fn background(c: Vec3) -> [u8; 4] {
+    [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0]
+}
+
+/// Fills `out` with background `c`.
+fn fill_rgba(out: &mut [[u8; 4]], c: Vec3) {
+    let px = background(c);
+    if px == [0; 4] {
+        // Black (the usual background): a byte fill, which compiles to `memset`,
+        // whose string stores clear a large frame without reading it first. A fill
+        // of 4-byte words is a vector loop that reads every line it writes.
+        bytemuck::cast_slice_mut::<[u8; 4], u8>(out).fill(0);
+    } else {
+        out.fill(px);
     }
+}
+
+/// [`ColorTarget::put`] of [`Rgba8`] and its bands.
+#[inline(always)]
+fn put_rgba(out: &mut [[u8; 4]], index: usize, c: Vec3) {
+    out[index] = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255];
+}
+
+/// [`ColorTarget::put_lanes`] of [`Rgba8`] and its bands.
+#[inline(always)]
+fn put_lanes_rgba<F: F32s>(
+    out: &mut [[u8; 4]],
+    start: usize,
+    stride: usize,
+    mask: u32,
+    c: &[F; 3],
+) {
+    // Pack to little-endian RGBA words and blend each row's 8 pixels in one store.
+    let [r, g, b] = each3!(|i| to_u8_lanes(c[i]));
+    let px = r | g.shl::<8>() | b.shl::<16>() | F::I::splat(0xFF << 24);
+    blend_lanes(out, start, stride, mask, px);
+}
+
+/// [`ColorTarget::put_lanes_grey`] of [`Rgba8`] and its bands.
+#[inline(always)]
+fn put_lanes_grey_rgba<F: F32s>(out: &mut [[u8; 4]], start: usize, stride: usize, mask: u32, g: F) {
+    // One conversion; the byte is copied to red, green and blue by shifts (a
+    // multiply by 0x010101 is the same bits but ends the shading's longest
+    // dependency chain with ten cycles of latency).
+    let v = to_u8_lanes(g);
+    let px = v | v.shl::<8>() | v.shl::<16>() | F::I::splat(0xFF << 24);
+    blend_lanes(out, start, stride, mask, px);
 }
 
 impl ColorTarget for Rgba8 {
     #[inline(always)]
     fn put(&mut self, index: usize, c: Vec3) {
-        self.0[index] = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255];
+        put_rgba(&mut self.0, index, c);
     }
     #[inline(always)]
     fn put_lanes<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, c: &[F; 3]) {
-        // Pack to little-endian RGBA words and blend each row's 8 pixels in one store.
-        let [r, g, b] = each3!(|i| to_u8_lanes(c[i]));
-        let px = r | g.shl::<8>() | b.shl::<16>() | F::I::splat(0xFF << 24);
-        self.blend_lanes(start, stride, mask, px);
+        put_lanes_rgba(&mut self.0, start, stride, mask, c);
     }
     #[inline(always)]
     fn put_lanes_grey<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, g: F) {
-        // One conversion; the byte is copied to red, green and blue by shifts (a
-        // multiply by 0x010101 is the same bits but ends the shading's longest
-        // dependency chain with ten cycles of latency).
-        let v = to_u8_lanes(g);
-        let px = v | v.shl::<8>() | v.shl::<16>() | F::I::splat(0xFF << 24);
-        self.blend_lanes(start, stride, mask, px);
+        put_lanes_grey_rgba(&mut self.0, start, stride, mask, g);
     }
     fn reset(&mut self, len: usize, c: Vec3) {
-        let px = [to_u8(c.x), to_u8(c.y), to_u8(c.z), 0];
         if self.0.len() != len {
             self.0.clear();
             crate::memory::reserve_frame(&mut self.0, len);
-            self.0.resize(len, px);
-        } else if px == [0; 4] {
-            // Black (the usual background): a byte fill, which compiles to `memset`,
-            // whose string stores clear a large frame without reading it first. A fill
-            // of 4-byte words is a vector loop that reads every line it writes.
-            bytemuck::cast_slice_mut::<[u8; 4], u8>(&mut self.0).fill(0);
+            self.0.resize(len, background(c));
         } else {
-            self.0.fill(px);
+            fill_rgba(&mut self.0, c);
         }
+    }
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    type Rows<'a> = Rgba8Rows<'a>;
+
+    fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = Rgba8Rows<'_>> {
+        self.0.par_chunks_mut(pixels).map(Rgba8Rows)
+    }
+}
+
+/// A band of rows of an [`Rgba8`] target (see [`ColorTarget::bands`]).
+#[derive(Debug)]
+pub struct Rgba8Rows<'a>(pub &'a mut [[u8; 4]]);
+
+impl ColorTarget for Rgba8Rows<'_> {
+    #[inline(always)]
+    fn put(&mut self, index: usize, c: Vec3) {
+        put_rgba(self.0, index, c);
+    }
+    #[inline(always)]
+    fn put_lanes<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, c: &[F; 3]) {
+        put_lanes_rgba(self.0, start, stride, mask, c);
+    }
+    #[inline(always)]
+    fn put_lanes_grey<F: F32s>(&mut self, start: usize, stride: usize, mask: u32, g: F) {
+        put_lanes_grey_rgba(self.0, start, stride, mask, g);
+    }
+    /// Fills the band (it cannot change size).
+    fn reset(&mut self, len: usize, c: Vec3) {
+        debug_assert_eq!(len, self.0.len(), "a band keeps its size");
+        fill_rgba(self.0, c);
+    }
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    type Rows<'a>
+        = Rgba8Rows<'a>
+    where
+        Self: 'a;
+
+    fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = Rgba8Rows<'_>> {
+        self.0.par_chunks_mut(pixels).map(Rgba8Rows)
     }
 }
 

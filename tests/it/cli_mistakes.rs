@@ -140,32 +140,34 @@ fn bench_render_explains_it_takes_a_model_not_a_scene() {
 }
 
 #[test]
-fn threads_accepts_only_one() {
+fn threads_takes_a_count_from_one() {
     let dir = scratch("threads");
     let (code, out, err) = run_in(&dir, &["bench", "render", "--help"]);
     assert_eq!(code, Some(0), "{err}");
-    assert!(out.contains("only 1 is accepted"), "{out}");
-    let (code, _, err) = run_in(
-        &dir,
-        &["bench", "render", "--threads", "2", "--frames", "1"],
-    );
-    assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("single-threaded: only 1 is accepted"), "{err}");
-    let (code, out, err) = run_in(
-        &dir,
-        &[
+    assert!(out.contains("the machine's cores"), "{out}");
+    for bad in ["0", "two", "1000"] {
+        let (code, _, err) = run_in(
+            &dir,
+            &["bench", "render", "--threads", bad, "--frames", "1"],
+        );
+        assert_eq!(code, Some(2), "{bad}: {err}");
+        assert!(err.contains("threads"), "{bad}: {err}");
+    }
+    for n in ["1", "2"] {
+        let args = [
             "bench",
             "render",
             "--threads",
-            "1",
+            n,
             "--frames",
             "1",
             "--size",
             "32x32",
-        ],
-    );
-    assert_eq!(code, Some(0), "{err}");
-    assert!(out.contains("median_ms="), "{out}");
+        ];
+        let (code, out, err) = run_in(&dir, &args);
+        assert_eq!(code, Some(0), "{err}");
+        assert!(out.contains(&format!("threads={n}")), "{out}");
+    }
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! Helpers shared by the integration tests.
 
 use glam::{Vec3, Vec4};
+use rayon::prelude::*;
 use termrast::raster::{CountGrid, CoverageSink, Setup, Target, Traversal, oracle};
 use termrast::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache, transform};
 
@@ -103,6 +104,53 @@ impl ColorTarget for Exact {
         self.colors.resize(len, None);
         self.writes.clear();
         self.writes.resize(len, 0);
+    }
+    fn len(&self) -> usize {
+        self.colors.len()
+    }
+
+    type Rows<'a> = ExactRows<'a>;
+
+    fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = ExactRows<'_>> {
+        let writes = self.writes.par_chunks_mut(pixels);
+        (self.colors.par_chunks_mut(pixels).zip(writes))
+            .map(|(colors, writes)| ExactRows { colors, writes })
+    }
+}
+
+/// A band of rows of an [`Exact`] target: a write outside the band fails the test.
+pub struct ExactRows<'a> {
+    colors: &'a mut [Option<Vec3>],
+    writes: &'a mut [u32],
+}
+
+impl ColorTarget for ExactRows<'_> {
+    fn put(&mut self, i: usize, c: Vec3) {
+        assert!(
+            i < self.colors.len(),
+            "write at {i} outside a band of {}",
+            self.colors.len()
+        );
+        self.colors[i] = Some(c);
+        self.writes[i] += 1;
+    }
+    fn reset(&mut self, _: usize, _: Vec3) {
+        self.colors.fill(None);
+        self.writes.fill(0);
+    }
+    fn len(&self) -> usize {
+        self.colors.len()
+    }
+
+    type Rows<'a>
+        = ExactRows<'a>
+    where
+        Self: 'a;
+
+    fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = ExactRows<'_>> {
+        let writes = self.writes.par_chunks_mut(pixels);
+        (self.colors.par_chunks_mut(pixels).zip(writes))
+            .map(|(colors, writes)| ExactRows { colors, writes })
     }
 }
 

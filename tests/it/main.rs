@@ -24,5 +24,6 @@ mod pipeline;
 mod scenes;
 mod serve;
 mod terminal;
+mod threads;
 mod tmux;
 mod wire;

@@ -55,7 +55,7 @@ pub struct SceneFrame {
     pub color: Rgba8,
     /// The supersampled frame (empty when the plan has no supersampling).
     fine: Rgba8,
-    pipelines: Vec<Box<dyn ObjectPipeline>>,
+    pipelines: Vec<Box<dyn ObjectPipeline + Send>>,
     pub silhouettes: Vec<Silhouette>,
     /// Counters of the last frame, all objects.
     pub stats: DrawStats,
@@ -134,6 +134,21 @@ impl SceneFrame {
 
     /// Draws a frame of `target` samples.
     pub fn draw(&mut self, scene: &Scene, target: Target, view: &SceneView) {
+        let side = u64::from(grid_side(scene.plan.samples)).pow(2);
+        let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
+        self.renderer.plan_frame(
+            target.len() as u64 * side + crate::render::TRIANGLE_WORK * triangles as u64,
+        );
+        match self.renderer.pool().cloned() {
+            // The whole frame on the pool: its steps then start their parallel work
+            // from one of its threads, without waking the pool for each.
+            Some(pool) => pool.install(|| self.draw_here(scene, target, view)),
+            None => self.draw_here(scene, target, view),
+        }
+    }
+
+    /// [`SceneFrame::draw`] on the calling thread.
+    fn draw_here(&mut self, scene: &Scene, target: Target, view: &SceneView) {
         let start = Instant::now();
         let plan = &scene.plan;
         let side = grid_side(plan.samples);
@@ -185,7 +200,7 @@ impl SceneFrame {
             &mut self.color
         };
         self.renderer
-            .begin_frame_with(fine, color, scene.background, plan.depth_buffer);
+            .begin_frame_deferred(fine, color, scene.background, plan.depth_buffer);
         let mut stats = DrawStats::default();
         let mut vertex = Duration::ZERO;
         for ((obj, op), pipe) in scene
@@ -199,6 +214,7 @@ impl SceneFrame {
             stats += self.renderer.stats;
             self.renderer.stats = DrawStats::default();
         }
+        self.renderer.finish_clear(color);
         self.wire = WireCount::default();
         for ((obj, op), pipe) in scene.objects.iter().zip(&plan.objects).zip(&self.pipelines) {
             if op.wireframe {

@@ -17,9 +17,7 @@ use crate::render::wire::{
     LineHit, ScreenLine, WIRE_COLOR, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under,
     probe_lines, project_edge,
 };
-use crate::render::{
-    Cull, DrawOptions, Renderer, Rgba8, Shader, VertexCache, ndc_to_screen, transform,
-};
+use crate::render::{Cull, DrawOptions, Renderer, Rgba8, Shader, VertexCache, ndc_to_screen};
 use crate::scene::plan::{ObjectPlan, VaryingSet};
 use crate::scene::{LightDesc, SceneObject};
 
@@ -168,7 +166,7 @@ impl<S: Shading> ObjectPipeline for Pipeline<S> {
     ) -> Duration {
         let start = Instant::now();
         let shader = S::shader(obj, plan, ctx);
-        transform(&shader, obj.mesh.positions.len(), &mut self.cache);
+        r.transform(&shader, obj.mesh.positions.len(), &mut self.cache);
         let vertex = start.elapsed();
         if plan.fill {
             let shaded = r.stats.shaded;
@@ -349,8 +347,8 @@ pub fn pipeline_for(
     obj: &SceneObject,
     plan: &ObjectPlan,
     lights: &[LightDesc],
-) -> Box<dyn ObjectPipeline> {
-    fn new<S: Shading>(varyings: VaryingSet) -> Box<dyn ObjectPipeline> {
+) -> Box<dyn ObjectPipeline + Send> {
+    fn new<S: Shading>(varyings: VaryingSet) -> Box<dyn ObjectPipeline + Send> {
         Box::new(Pipeline::<S> {
             cache: VertexCache::default(),
             varyings,

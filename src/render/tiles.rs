@@ -1,0 +1,370 @@
+//! Drawing on several threads, with the frame one thread would draw, bit for bit.
+//!
+//! A draw runs in three parallel steps on the renderer's thread pool:
+//!
+//! 1. **Vertices**: every vertex is projected once ([`Projected::of`]), in parallel
+//!    chunks of the vertex array (the vertex stage itself runs the same way in
+//!    [`super::Renderer::transform`]).
+//! 2. **Set-up and binning**: the triangles are cut into chunks of consecutive
+//!    triangles; each chunk's thread clips and sets up its triangles once
+//!    ([`prepare_projected`], as on one thread) into the chunk's records, in draw order,
+//!    and files each record's index in the bin of every band its box touches.
+//! 3. **Walk**: each band is walked by one thread, which takes the bins of every
+//!    chunk in chunk order: the triangles of a band reach its depth test and its
+//!    colour writes in draw order, as on one thread. A triangle that crosses bands is
+//!    walked in each with its box cut to the band's rows ([`Setup::rows`], the same
+//!    edge values at every pixel), so every pixel gets the same fragments, in the same
+//!    order, through the same copy of the draw loop ([`super::DrawCopy::choose`]).
+//!
+//! The tiles are bands of whole rows ([`BAND_ROWS`] high) rather than squares: a band
+//! is one contiguous slice of the colour target and one of the depth buffer (and its
+//! clear bits), so the threads own disjoint borrows and no lock or atomic is needed;
+//! and the `wide` walk puts 8-pixel groups anywhere on a row (a group may start left of
+//! a narrow box) and the 8-lane copies store a whole group with a blend, so two threads
+//! must not share a row. Bands are a multiple of the 8-pixel block and of the depth
+//! buffer's clear tile, so the block walk's trivial accept and reject work per band and
+//! no clear tile is shared. The records, bins and projections are kept from draw to
+//! draw: a steady frame allocates nothing.
+
+use std::any::Any;
+use std::ops::Range;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::Renderer;
+use super::fragments::PieceWalker;
+use super::isa::DrawVariant;
+use super::options::{DrawOptions, DrawStats};
+use super::prepare::{
+    EmitPiece, PrepareOutcome, Prepared, Projected, VertexCache, prepare_projected,
+};
+use super::shader::Shader;
+use super::target::ColorTarget;
+use crate::raster::clip::guard_band_ndc;
+use crate::raster::depth::DepthRows;
+use crate::raster::{Setup, Target};
+use crate::simd::I32s;
+
+/// Rows per band: a multiple of the block traversal's 8 and of the depth clear tile.
+/// Chosen by measurement (see `docs/performance.md`).
+pub const BAND_ROWS: u32 = 48;
+
+/// Triangles per chunk of a batch (see [`draw`]): a batch's records stay a few
+/// megabytes however large the mesh.
+const CHUNK_TRIANGLES: usize = 4096;
+
+/// Chunks of triangles per thread in the set-up step: enough that a thread that
+/// finishes early takes another.
+const CHUNKS_PER_THREAD: usize = 4;
+
+/// Vertices per parallel job of the vertex steps (smaller jobs cost more to hand out
+/// than they save).
+pub(super) const VERTEX_JOB: usize = 2048;
+
+/// A run of consecutive triangles set up by one thread.
+#[derive(Debug)]
+pub(super) struct Chunk<V> {
+    /// The pieces that reached the rasterizer, in draw order.
+    records: Vec<Prepared<V>>,
+    /// Per band, the indices in `records` of the pieces whose box touches it, ascending.
+    bins: Vec<Vec<u32>>,
+    /// The triangle counters of the chunk (the fragment counters come from the walk).
+    stats: DrawStats,
+}
+
+impl<V> Default for Chunk<V> {
+    fn default() -> Self {
+        Self {
+            records: Vec::new(),
+            bins: Vec::new(),
+            stats: DrawStats::default(),
+        }
+    }
+}
+
+/// Every chunk of a draw, for one varying type.
+#[derive(Debug)]
+struct Bins<V> {
+    chunks: Vec<Chunk<V>>,
+}
+
+/// What the threaded path keeps between draws: the chunks of each varying type drawn
+/// so far (a scene's objects may differ), so that a steady frame reuses them.
+#[derive(Default)]
+pub(super) struct Scratch {
+    bins: Vec<Box<dyn Any + Send>>,
+}
+
+impl std::fmt::Debug for Scratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Scratch")
+            .field("varying_types", &self.bins.len())
+            .finish()
+    }
+}
+
+impl Scratch {
+    /// The chunks for varying type `V`: `chunks` of them, each with `bands` empty bins.
+    fn chunks<V: Send + 'static>(&mut self, chunks: usize, bands: usize) -> &mut [Chunk<V>] {
+        let i = match self.bins.iter().position(|b| (**b).is::<Bins<V>>()) {
+            Some(i) => i,
+            None => {
+                self.bins.push(Box::new(Bins::<V> { chunks: Vec::new() }));
+                self.bins.len() - 1
+            }
+        };
+        let bins = self.bins[i]
+            .downcast_mut::<Bins<V>>()
+            .expect("the entry's type was just checked");
+        bins.chunks.resize_with(chunks, Chunk::default);
+        for c in &mut bins.chunks {
+            c.bins.resize_with(bands, Vec::new);
+        }
+        &mut bins.chunks[..chunks]
+    }
+}
+
+/// What every thread of a draw reads.
+pub(super) struct Job<'a, S: Shader> {
+    shader: &'a S,
+    cache: &'a VertexCache<S::Varying>,
+    projected: &'a [Projected],
+    indices: &'a [u32],
+    opts: DrawOptions,
+    target: Target,
+    /// Rows per band (a multiple of 8).
+    band_rows: u32,
+}
+
+/// The two steps of a threaded draw that run a copy of the draw loop, compiled for
+/// the copy's instruction set and variant (implemented in `isa`'s modules).
+pub(super) trait TileCopy {
+    /// Sets up triangles `range` into `chunk` (see [`setup_chunk`]).
+    ///
+    /// # Safety
+    /// The CPU must have the copy's instruction set.
+    unsafe fn setup<S: Shader>(job: &Job<'_, S>, range: Range<u32>, chunk: &mut Chunk<S::Varying>);
+
+    /// Walks band `band` of every chunk into its rows of colour and depth, first
+    /// filling the colour rows with `clear` if given (see [`walk_band`]); returns its
+    /// fragment counters.
+    ///
+    /// # Safety
+    /// As for [`TileCopy::setup`].
+    unsafe fn walk<S: Shader, C: ColorTarget>(
+        job: &Job<'_, S>,
+        chunks: &[Chunk<S::Varying>],
+        band: usize,
+        color: &mut C,
+        depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
+    ) -> DrawStats;
+}
+
+/// Draws on the renderer's pool with copy `T`: the threaded form of
+/// `Renderer::draw_triangles`, with the same frame and counters.
+///
+/// # Safety
+/// The CPU must have `T`'s instruction set (as [`super::DrawCopy::choose`] ensures).
+pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
+    r: &mut Renderer,
+    shader: &S,
+    cache: &VertexCache<S::Varying>,
+    indices: &[u32],
+    opts: &DrawOptions,
+    color: &mut C,
+) {
+    let Some(pool) = r.pool.as_ref() else {
+        unreachable!("a threaded draw without a pool");
+    };
+    let target = r.target;
+    let band_rows = r.band_rows;
+    let bands = target.height.div_ceil(band_rows) as usize;
+    let triangles = indices.len() / 3;
+    let n = (pool.current_num_threads() * CHUNKS_PER_THREAD).clamp(1, triangles.max(1));
+    let chunks = r.scratch.chunks::<S::Varying>(n, bands);
+    let projected = &mut r.projected;
+    let depth = &mut r.depth;
+    let mut clear = r.pending_clear.take();
+    let stats = pool.install(|| {
+        let guard = guard_band_ndc(target.width, target.height);
+        projected.clear();
+        projected.par_extend(
+            cache
+                .verts
+                .par_iter()
+                .with_min_len(VERTEX_JOB)
+                .map(|v| Projected::of(v.pos, target, guard)),
+        );
+        let job = Job {
+            shader,
+            cache,
+            projected,
+            indices,
+            opts: *opts,
+            target,
+            band_rows,
+        };
+        let mut stats = DrawStats::default();
+        // Batches of triangles, each set up and then walked, so the records of a large
+        // mesh are a few megabytes reused, not one record per triangle of the mesh.
+        let batch = n * CHUNK_TRIANGLES;
+        // At least one batch: it also clears the colour if that is pending.
+        for first in (0..triangles.max(1)).step_by(batch) {
+            let count = batch.min(triangles.saturating_sub(first));
+            let clear = clear.take();
+            let part = |c: usize| (first + count * c / n) as u32;
+            chunks
+                .par_iter_mut()
+                .enumerate()
+                .with_max_len(1)
+                .for_each(|(c, chunk)| {
+                    // SAFETY: the caller's guarantee.
+                    unsafe { T::setup(&job, part(c)..part(c + 1), chunk) };
+                });
+            let chunks = &*chunks;
+            let colors = color.bands(band_rows as usize * target.width as usize);
+            assert_eq!(
+                colors.len(),
+                bands,
+                "the colour target is not the frame's size"
+            );
+            let walked = colors
+                .zip(depth.bands(band_rows))
+                .enumerate()
+                .with_max_len(1)
+                .map(|(b, (mut color, mut depth))| {
+                    // SAFETY: the caller's guarantee.
+                    unsafe { T::walk(&job, chunks, b, &mut color, &mut depth, clear) }
+                })
+                .reduce(DrawStats::default, |mut a, b| {
+                    a += b;
+                    a
+                });
+            stats += walked;
+            for c in chunks {
+                stats += c.stats;
+            }
+        }
+        stats
+    });
+    r.stats += stats;
+}
+
+/// Files each piece into its chunk and the bins of the bands its box touches.
+struct Binner<'a, V> {
+    chunk: &'a mut Chunk<V>,
+    band_rows: u32,
+}
+
+impl<V: Copy> EmitPiece<V> for Binner<'_, V> {
+    #[inline(always)]
+    fn piece(&mut self, p: &Prepared<V>) {
+        let b = p.setup.bbox;
+        // A box of at most four pixels covering none of them (most triangles of a mesh
+        // far denser than the pixels) would be walked for nothing: it is not stored.
+        // The stale depth tiles the walk would have filled read as cleared anyway.
+        if b.width() * b.height() <= 4 && !covers_any(&p.setup) {
+            return;
+        }
+        let c = &mut *self.chunk;
+        let i = c.records.len() as u32;
+        c.records.push(*p);
+        for band in b.y0 / self.band_rows..b.y1 / self.band_rows + 1 {
+            c.bins[band as usize].push(i);
+        }
+    }
+}
+
+/// Whether any pixel of a setup's box is covered.
+#[inline(always)]
+fn covers_any(s: &Setup) -> bool {
+    let b = s.bbox;
+    for y in b.y0..=b.y1 {
+        for x in b.x0..=b.x1 {
+            let f = s.edges(i64::from(x), i64::from(y));
+            if f[0] >= 0 && f[1] >= 0 && f[2] >= 0 {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// Sets up triangles `range` of the draw into `chunk`, counting them as one thread
+/// does: the body of every copy's [`TileCopy::setup`].
+#[inline(always)]
+pub(super) fn setup_chunk<S: Shader>(
+    job: &Job<'_, S>,
+    range: Range<u32>,
+    chunk: &mut Chunk<S::Varying>,
+) {
+    chunk.records.clear();
+    for b in &mut chunk.bins {
+        b.clear();
+    }
+    let mut stats = DrawStats::default();
+    let mut binner = Binner {
+        chunk,
+        band_rows: job.band_rows,
+    };
+    let pv = Some(job.projected);
+    for t in range {
+        stats.triangles += 1;
+        let (cache, indices, target, cull) = (job.cache, job.indices, job.target, job.opts.cull);
+        match prepare_projected(cache, pv, indices, t, target, cull, &mut binner) {
+            PrepareOutcome::Rejected => stats.rejected += 1,
+            PrepareOutcome::Culled => stats.culled += 1,
+            PrepareOutcome::Drawn { clipped } => {
+                stats.drawn += 1;
+                stats.clipped += u64::from(clipped);
+            }
+        }
+    }
+    binner.chunk.stats = stats;
+}
+
+/// Walks band `band` (its rows of `color` and `depth`) through every chunk's bin in
+/// chunk order, so in draw order, with variant `V` on lanes `L`: the body of every
+/// copy's [`TileCopy::walk`].
+#[inline(always)]
+pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
+    job: &Job<'_, S>,
+    chunks: &[Chunk<S::Varying>],
+    band: usize,
+    color: &mut C,
+    depth: &mut DepthRows<'_>,
+    clear: Option<Vec3>,
+) -> DrawStats {
+    if let Some(background) = clear {
+        // The frame's deferred clear, a band at a time: its lines are then in this
+        // core's cache when the walk writes them.
+        let len = color.len();
+        color.reset(len, background);
+    }
+    let y0 = band as u32 * job.band_rows;
+    let y1 = (y0 + job.band_rows).min(job.target.height) - 1;
+    let mut walker =
+        PieceWalker::<S, C, L, V, _>::new(job.shader, depth, color, &job.opts, job.target);
+    for chunk in chunks {
+        for &i in &chunk.bins[band] {
+            let tri = &chunk.records[i as usize];
+            let b = tri.setup.bbox;
+            let cut: Setup;
+            // One call of the walk (it is inlined): a box within the band is walked as
+            // it is, one across its edge as its rows in the band.
+            let setup = if b.y0 >= y0 && b.y1 <= y1 {
+                &tri.setup
+            } else {
+                let Some(s) = tri.setup.rows(y0, y1) else {
+                    continue;
+                };
+                cut = s;
+                &cut
+            };
+            walker.walk(tri, setup);
+        }
+    }
+    walker.stats
+}

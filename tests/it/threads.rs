@@ -1,0 +1,286 @@
+//! Drawing on several threads: the frame (colour and depth bits) and the counters
+//! equal one thread's for every model and scene, traversal, interpolation mode and
+//! instruction set, on targets smaller than a band and across bands; the probe still
+//! equals the framebuffer; triangles crossing a band's border at every subpixel
+//! offset, and random ones, draw the same fragments in the same order.
+
+use glam::{Vec3, Vec4};
+use proptest::prelude::*;
+use termrast::raster::depth::{DepthFunc, DepthState};
+use termrast::raster::interp::Interpolation;
+use termrast::raster::{Target, Traversal};
+use termrast::render::probe::DepthOutcome;
+use termrast::render::target::to_u8;
+use termrast::render::{BAND_ROWS, DrawOptions, DrawStats, Isa, Renderer, VertexCache};
+use termrast::scene::Scene;
+use termrast::scene::render::{SceneFrame, SceneView};
+
+use crate::common::{Direct, Exact};
+
+/// A frame's colour, depth bits and counters.
+type Bits = (Vec<[u8; 4]>, Vec<u32>, DrawStats);
+
+/// One frame of `scene` drawn on `threads` threads.
+fn frame_bits(
+    scene: &Scene,
+    target: Target,
+    view: &SceneView,
+    (interpolation, traversal, isa): (Interpolation, Traversal, Isa),
+    threads: usize,
+) -> Bits {
+    let mut frame = SceneFrame::new(scene);
+    frame.renderer.isa = isa;
+    frame.renderer.set_threads(threads);
+    frame.renderer.min_threaded_work = 0;
+    assert_eq!(frame.renderer.threads(), threads);
+    frame.interpolation = interpolation;
+    frame.traversal = traversal;
+    frame.draw(scene, target, view);
+    let depth = frame.renderer.depth.to_vec();
+    let depth = depth.iter().map(|d| d.to_bits()).collect();
+    (frame.color.0, depth, frame.stats)
+}
+
+fn turned(yaw: f32) -> SceneView {
+    SceneView {
+        yaw,
+        ..SceneView::default()
+    }
+}
+
+fn model(spec: &str) -> Scene {
+    Scene::standard(spec).expect("the model loads")
+}
+
+fn scene_file(name: &str) -> Scene {
+    let path = format!("{}/examples/scenes/{name}", env!("CARGO_MANIFEST_DIR"));
+    Scene::load(std::path::Path::new(&path)).expect("the scene loads")
+}
+
+/// Every way to draw: each interpolation mode with each traversal, on each
+/// instruction set this CPU has.
+fn every_option() -> Vec<(Interpolation, Traversal, Isa)> {
+    let mut out = Vec::new();
+    for interpolation in Interpolation::ALL {
+        for traversal in Traversal::ALL {
+            for isa in Isa::supported() {
+                out.push((interpolation, traversal, isa));
+            }
+        }
+    }
+    out
+}
+
+/// Models (the lane-code Lambert pipeline) and scene files (the packed pipelines,
+/// textures, depth shading, several objects, culling) at a size of several bands
+/// whose height is not a multiple of one: every option on 2 and 3 threads gives the
+/// frame and counters of 1 thread.
+#[test]
+fn threaded_frames_equal_one_thread_for_every_model_option_and_isa() {
+    let target = Target::new(97, 2 * BAND_ROWS + 11);
+    let scenes = [
+        ("teapot", model("teapot")),
+        ("bunny", model("bunny")),
+        ("sphere:3000", model("sphere:3000")),
+        ("textured-cube", scene_file("textured-cube.toml")),
+        ("depth-map", scene_file("depth-map.toml")),
+        ("silhouettes", scene_file("silhouettes.toml")),
+    ];
+    for (name, scene) in &scenes {
+        let view = turned(0.9);
+        for options in every_option() {
+            let one = frame_bits(scene, target, &view, options, 1);
+            assert!(one.2.shaded > 500, "{name} covers the frame");
+            for threads in [2, 3] {
+                let many = frame_bits(scene, target, &view, options, threads);
+                assert!(one == many, "{name} {options:?} on {threads} threads");
+            }
+        }
+    }
+}
+
+/// Targets smaller than a band, a group or a pixel row of a band, one band exactly and
+/// just over one, the model reaching past every side.
+#[test]
+fn targets_smaller_than_a_band_draw_the_same_frame() {
+    let mut scene = model("bunny");
+    scene.camera.eye = Vec3::new(0.0, 0.0, 1.3);
+    let view = turned(0.4);
+    let b = BAND_ROWS;
+    for (w, h) in [
+        (1, 1),
+        (3, 5),
+        (7, 6),
+        (8, 4),
+        (9, 9),
+        (17, 10),
+        (40, b - 1),
+        (40, b),
+        (40, b + 1),
+        (33, 2 * b + 3),
+    ] {
+        let target = Target::new(w, h);
+        for options in every_option() {
+            let one = frame_bits(&scene, target, &view, options, 1);
+            let two = frame_bits(&scene, target, &view, options, 2);
+            assert!(one == two, "{w}x{h} {options:?}");
+        }
+    }
+}
+
+/// The probe, which recomputes a pixel from scratch on one thread, equals the frame
+/// drawn on two at every pixel.
+#[test]
+fn probe_equals_the_threaded_framebuffer() {
+    let mut scene = model("bunny");
+    let target = Target::new(120, 90);
+    for (angle, cull) in [(0.7f32, false), (2.1, true)] {
+        scene.set_cull(cull);
+        let mut frame = SceneFrame::new(&scene);
+        frame.renderer.set_threads(2);
+        frame.renderer.min_threaded_work = 0;
+        frame.draw(&scene, target, &turned(angle));
+        let mut winners = 0;
+        for y in 0..target.height {
+            for x in 0..target.width {
+                let p = &frame.probe(&scene, x, y)[0];
+                let i = (y * target.width + x) as usize;
+                let depth = frame.renderer.depth.at(i);
+                assert_eq!(p.final_depth.to_bits(), depth.to_bits(), "({x},{y})");
+                let want = p.winner.map_or([0; 4], |w| {
+                    assert!(matches!(p.records[w].depth, DepthOutcome::Passed { .. }));
+                    let c = p.records[w].varying.expect("a passing fragment is shaded");
+                    winners += 1;
+                    [to_u8(c.x), to_u8(c.y), to_u8(c.z), 255]
+                });
+                assert_eq!(frame.color.0[i], want, "({x},{y})");
+            }
+        }
+        assert!(winners > 2000, "the bunny covers the frame ({winners})");
+    }
+}
+
+/// What a draw of `shader` leaves: the exact colours, the writes per pixel, the depth
+/// bits and the counters.
+type Drawn = (Vec<Option<Vec3>>, Vec<u32>, Vec<u32>, DrawStats);
+
+/// Draws `shader`'s triangles on `threads` threads into an [`Exact`] target, which
+/// fails the test on a write outside the band being drawn.
+fn draw_direct(
+    shader: &Direct,
+    indices: &[u32],
+    target: Target,
+    opts: &DrawOptions,
+    threads: usize,
+) -> Drawn {
+    let mut r = Renderer::new(target);
+    r.set_threads(threads);
+    r.min_threaded_work = 0;
+    let mut out = Exact::default();
+    let mut cache = VertexCache::default();
+    r.begin_frame(target, &mut out, Vec3::ZERO);
+    r.transform(shader, shader.clip.len(), &mut cache);
+    r.draw(shader, &cache, indices, opts, &mut out);
+    let depth = r.depth.to_vec().iter().map(|d| d.to_bits()).collect();
+    (out.colors, out.writes, depth, r.stats)
+}
+
+/// Clip-space position (w = 1) of a point given in pixels of `target`, at depth `z`.
+fn at_pixel(target: Target, x: f32, y: f32, z: f32) -> Vec4 {
+    let (w, h) = (target.width as f32, target.height as f32);
+    Vec4::new(x / w * 2.0 - 1.0, 1.0 - y / h * 2.0, z, 1.0)
+}
+
+/// The options a property test draws with: any traversal and interpolation, and
+/// depth tests where the order of equal depths decides.
+fn options(traversal: Traversal, interpolation: Interpolation, func: DepthFunc) -> DrawOptions {
+    DrawOptions {
+        traversal,
+        interpolation,
+        depth: DepthState { func, write: true },
+        ..DrawOptions::default()
+    }
+}
+
+/// Triangles with a vertex on each side of the first band border, the border crossed
+/// at every one of the 256 subpixel offsets (and vertices exactly on it), overlapping
+/// at equal and unequal depths so the order of the writes shows: the same exact
+/// colours, writes per pixel, depth and counters on 1 and 2 threads, for every
+/// traversal.
+#[test]
+fn triangles_crossing_a_band_border_at_every_subpixel_draw_the_same() {
+    let target = Target::new(48, 2 * BAND_ROWS + 5);
+    let border = BAND_ROWS as f32;
+    for sub in 0..256u32 {
+        let off = sub as f32 / 256.0;
+        let y = border - 0.5 + off;
+        let p = |x: f32, y: f32, z: f32| at_pixel(target, x, y, z);
+        let clip = vec![
+            // A fan around a vertex near the border.
+            p(20.0 + off, y, 0.5),
+            p(3.0, y - 9.0 - off, 0.2),
+            p(41.0, y - 1.0 + off, 0.7),
+            p(37.0 - off, y + 12.0, 0.3),
+            p(2.0 + off, y + 3.0 - off, 0.6),
+            // A thin sliver along the border and a triangle with an edge on it.
+            p(0.5, y, 0.5),
+            p(47.5, y + off, 0.5),
+            p(24.0, y + 0.75, 0.5),
+            p(5.0, border, 0.4),
+            p(30.0 + off, border, 0.4),
+            p(17.0, border + 6.0 * off, 0.4),
+        ];
+        let attr = (0..clip.len())
+            .map(|i| Vec3::new(i as f32, off, 1.0 - off))
+            .collect();
+        let shader = Direct { clip, attr };
+        let indices = [
+            0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 5, 6, 7, 8, 9, 10, 1, 3, 2,
+        ];
+        for traversal in Traversal::ALL {
+            for func in [DepthFunc::Less, DepthFunc::LessEqual, DepthFunc::Always] {
+                let o = options(traversal, Interpolation::Perspective, func);
+                let one = draw_direct(&shader, &indices, target, &o, 1);
+                assert!(one.3.fragments > 100, "{sub}: the fan covers pixels");
+                let two = draw_direct(&shader, &indices, target, &o, 2);
+                assert!(one == two, "subpixel {sub}, {traversal:?}, {func:?}");
+            }
+        }
+    }
+}
+
+fn vertex() -> impl Strategy<Value = Vec4> {
+    // Mostly on the target, some past its sides (clipped) or behind the eye.
+    (-1.4f32..1.4, -1.4f32..1.4, -0.2f32..1.1, 0.3f32..2.0)
+        .prop_map(|(x, y, z, w)| Vec4::new(x * w, y * w, z * w, w))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Random triangles, any traversal, interpolation and depth test, on targets
+    /// from one band to several: 1, 2 and 3 threads draw the same.
+    #[test]
+    fn random_triangles_draw_the_same_on_every_thread_count(
+        clip in prop::collection::vec(vertex(), 3..40),
+        tris in prop::collection::vec(any::<[prop::sample::Index; 3]>(), 1..30),
+        (w, h) in (1u32..90, 1u32..(3 * BAND_ROWS + 7)),
+        traversal in prop::sample::select(Traversal::ALL.to_vec()),
+        interpolation in prop::sample::select(Interpolation::ALL.to_vec()),
+        func in prop::sample::select(vec![DepthFunc::Less, DepthFunc::LessEqual, DepthFunc::Always]),
+    ) {
+        let target = Target::new(w, h);
+        let indices: Vec<u32> = tris
+            .iter()
+            .flat_map(|t| t.map(|i| i.index(clip.len()) as u32))
+            .collect();
+        let attr = clip.iter().map(|p| p.truncate().abs()).collect();
+        let shader = Direct { clip, attr };
+        let o = options(traversal, interpolation, func);
+        let one = draw_direct(&shader, &indices, target, &o, 1);
+        for threads in [2, 3] {
+            let many = draw_direct(&shader, &indices, target, &o, threads);
+            prop_assert!(one == many, "{} threads", threads);
+        }
+    }
+}

@@ -499,3 +499,86 @@ fn a_dumb_terminal_gets_a_message_not_a_full_screen_interface() {
     assert!(s.contains("EXIT=1"), "{s}");
     assert_eq!(t.flags(), "0 0 1", "the terminal was left as it was");
 }
+
+/// The colours tmux shows (`capture-pane -e`) for a model of two materials, red on
+/// the left and blue on the right, and the loader's warning on the terminal after `q`.
+#[test]
+fn a_model_shows_its_materials_colours_in_the_terminal() {
+    let Some(t) = Tmux::new("materials") else {
+        eprintln!("tmux not installed: skipped");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("termrast-tmux-mtl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("c.mtl"),
+        "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\nKd 1 2\n",
+    )
+    .unwrap();
+    let obj = dir.join("two.obj");
+    std::fs::write(
+        &obj,
+        "mtllib c.mtl\nv -1 -1 0\nv 0 -1 0\nv 0 1 0\nv -1 1 0\nv 0 -1 0\nv 1 -1 0\nv 1 1 0\nv 0 1 0\n\
+         usemtl red\nf 1 2 3 4\nusemtl blue\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    t.start_viewer_with(
+        "TERM=xterm-256color COLORTERM=truecolor LANG=C.UTF-8",
+        &format!("{} --glyphs blocks", obj.display()),
+    );
+    // Paused, so the square faces the camera and stays.
+    t.keys(&["Space"]);
+    sleep(Duration::from_millis(500));
+    let shown = t
+        .run(&["capture-pane", "-e", "-p", "-t", "t"])
+        .unwrap_or_default();
+    let sgr = truecolor_colours(&shown);
+    let red = sgr
+        .iter()
+        .filter(|c| c[0] > 100 && c[1] < 30 && c[2] < 30)
+        .count();
+    let blue = sgr
+        .iter()
+        .filter(|c| c[2] > 100 && c[0] < 30 && c[1] < 30)
+        .count();
+    assert!(
+        red > 0 && blue > 0,
+        "red {red}, blue {blue} colours shown:\n{shown}"
+    );
+    t.keys(&["q"]);
+    let after = t.wait_for_exit();
+    assert!(
+        after.contains("warning:") && after.contains("c.mtl:5:"),
+        "{after}"
+    );
+}
+
+/// The truecolor foreground and background colours (`38;2;r;g;b`, `48;2;…`) in
+/// captured text.
+fn truecolor_colours(text: &str) -> Vec<[u8; 3]> {
+    let mut out = Vec::new();
+    for part in text.split("\x1b[").skip(1) {
+        let params: Vec<&str> = part
+            .split(|c: char| c.is_ascii_alphabetic())
+            .next()
+            .unwrap_or("")
+            .split(';')
+            .collect();
+        let mut i = 0;
+        while i + 4 < params.len() {
+            if (params[i] == "38" || params[i] == "48") && params.get(i + 1) == Some(&"2") {
+                let c: Vec<u8> = params[i + 2..(i + 5).min(params.len())]
+                    .iter()
+                    .filter_map(|p| p.parse().ok())
+                    .collect();
+                if let [r, g, b] = c[..] {
+                    out.push([r, g, b]);
+                }
+                i += 5;
+            } else {
+                i += 1;
+            }
+        }
+    }
+    out
+}

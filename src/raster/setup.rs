@@ -350,22 +350,38 @@ fn in_band(c: i64) -> bool {
     c.abs() <= (GUARD_BAND_PX as i64) * SUBPIXEL_ONE
 }
 
-/// Pixels whose centres lie within the vertices' bounding box, clipped to the target.
+/// Per axis, the first and last pixel whose centre lies within the snapped vertices'
+/// extent (unclamped to any target).
 #[inline(always)]
-fn pixel_bounds(v: &[[i64; 2]; 3], target: Target) -> Option<PixelRect> {
-    if target.is_empty() {
-        return None;
-    }
+fn centre_span(v: &[[i64; 2]; 3]) -> [[i64; 2]; 2] {
     // Written out: iterator chains here stay out of line in the renderer's loop.
     let lo = |c: usize| v[0][c].min(v[1][c]).min(v[2][c]);
     let hi = |c: usize| v[0][c].max(v[1][c]).max(v[2][c]);
     // Centre of pixel n is n*256 + 128: first centre ≥ lo, last centre ≤ hi.
     let first = |lo: i64| (lo - HALF_PIXEL + SUBPIXEL_ONE - 1).div_euclid(SUBPIXEL_ONE);
     let last = |hi: i64| (hi - HALF_PIXEL).div_euclid(SUBPIXEL_ONE);
-    let x0 = first(lo(0)).max(0);
-    let y0 = first(lo(1)).max(0);
-    let x1 = last(hi(0)).min(i64::from(target.width) - 1);
-    let y1 = last(hi(1)).min(i64::from(target.height) - 1);
+    [[first(lo(0)), last(hi(0))], [first(lo(1)), last(hi(1))]]
+}
+
+/// Whether the box of a triangle with snapped vertices `v` would hold pixel `(x, y)`
+/// of a target that holds the pixel: [`Setup::bbox`]'s test, without the set-up.
+#[inline]
+#[must_use]
+pub fn box_holds(v: &[[i64; 2]; 3], x: u32, y: u32) -> bool {
+    let [[x0, x1], [y0, y1]] = centre_span(v);
+    (x0..=x1).contains(&i64::from(x)) && (y0..=y1).contains(&i64::from(y))
+}
+
+/// Pixels whose centres lie within the vertices' bounding box, clipped to the target.
+#[inline(always)]
+fn pixel_bounds(v: &[[i64; 2]; 3], target: Target) -> Option<PixelRect> {
+    if target.is_empty() {
+        return None;
+    }
+    let [[x0, x1], [y0, y1]] = centre_span(v);
+    let (x0, y0) = (x0.max(0), y0.max(0));
+    let x1 = x1.min(i64::from(target.width) - 1);
+    let y1 = y1.min(i64::from(target.height) - 1);
     if x0 > x1 || y0 > y1 {
         return None;
     }

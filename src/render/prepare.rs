@@ -13,7 +13,7 @@ use crate::raster::clip::{
     ClipOutcome, ClipVertex, classify_codes, clip_straddling, guard_band_ndc, outcode,
 };
 use crate::raster::interp::Varying;
-use crate::raster::setup::snap;
+use crate::raster::setup::{box_holds, snap};
 use crate::raster::{SUBPIXEL_BITS, Setup, Target};
 use crate::simd::each3;
 
@@ -133,6 +133,18 @@ impl Projected {
             z: pos.z * inv_w,
             fixed: [sx.unwrap_or(0), sy.unwrap_or(0)],
         }
+    }
+
+    /// Whether a triangle of these vertices surely leaves pixel `(x, y)` alone: it is
+    /// drawn unclipped (inside every plane, every vertex snapped) and its box misses
+    /// the pixel. Exact, as set-up boxes the same snapped vertices; a triangle that
+    /// needs clipping answers `false` and is left to [`prepare_projected`].
+    #[inline]
+    #[must_use]
+    pub fn box_misses(pv: [Self; 3], x: u32, y: u32) -> bool {
+        classify_codes(each3!(|i| pv[i].out)) == ClipOutcome::Inside
+            && pv.iter().all(|p| p.snapped)
+            && !box_holds(&each3!(|i| pv[i].fixed), x, y)
     }
 }
 

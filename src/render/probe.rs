@@ -4,9 +4,12 @@
 //! per-triangle preparation for every triangle in draw order, keeps those whose
 //! bounding box holds the pixel, evaluates them with the renderer's own per-pixel code
 //! and replays the depth test. Its answers therefore equal what the renderer did
-//! (the tests check every pixel of a frame).
+//! (the tests check every pixel of a frame). A triangle drawn unclipped whose box
+//! misses the pixel is passed over after a box test of its snapped vertices, which is
+//! the test set-up makes, so probing a large mesh stays fast.
 
-use super::{DrawOptions, PixelEval, Prepared, VertexCache, prepare};
+use super::prepare::{Projected, prepare_projected, project_vertices};
+use super::{DrawOptions, PixelEval, Prepared, VertexCache};
 use crate::raster::depth::DEPTH_CLEAR;
 use crate::raster::interp::Varying;
 use crate::raster::traverse::{BlockClass, DEFAULT_BLOCK, block_containing, classify_block};
@@ -107,40 +110,57 @@ pub fn probe_from<V: Varying>(
         return out;
     }
     let mut stored = stored;
-    for t in 0..(indices.len() / 3) as u32 {
-        let _ = prepare(cache, indices, t, target, opts.cull, &mut |p: &Prepared<
-            V,
-        >| {
-            let s = &p.setup;
-            if !s.bbox.contains(x, y) {
-                return;
-            }
-            let eval = p.eval(x, y);
-            let depth = if !eval.covered {
-                DepthOutcome::NotCovered
-            } else if depth_state.func.passes(eval.depth, stored) {
-                let against = stored;
-                if depth_state.write {
-                    stored = eval.depth;
+    // Each vertex projected once, as the threaded renderer does (the same set-ups),
+    // so that the many triangles whose box misses the pixel cost a box test.
+    let mut projected = Vec::new();
+    project_vertices(cache, target, &mut projected);
+    for (t, idx) in indices.chunks_exact(3).enumerate() {
+        let get = |i: u32| projected.get(i as usize).copied();
+        if let (Some(a), Some(b), Some(c)) = (get(idx[0]), get(idx[1]), get(idx[2]))
+            && Projected::box_misses([a, b, c], x, y)
+        {
+            continue;
+        }
+        let t = t as u32;
+        let _ = prepare_projected(
+            cache,
+            Some(&projected),
+            indices,
+            t,
+            target,
+            opts.cull,
+            &mut |p: &Prepared<V>| {
+                let s = &p.setup;
+                if !s.bbox.contains(x, y) {
+                    return;
                 }
-                out.winner = Some(out.records.len());
-                DepthOutcome::Passed { against }
-            } else {
-                DepthOutcome::Failed { against: stored }
-            };
-            let block = block_containing(s, DEFAULT_BLOCK, x, y)
-                .map_or(BlockClass::Outside, |r| classify_block(s, r));
-            out.records.push(ProbeRecord {
-                triangle: p.triangle,
-                piece: p.piece,
-                clipped: p.clipped,
-                setup: *s,
-                eval,
-                depth,
-                block,
-                varying: p.varyings(&eval, interpolation),
-            });
-        });
+                let eval = p.eval(x, y);
+                let depth = if !eval.covered {
+                    DepthOutcome::NotCovered
+                } else if depth_state.func.passes(eval.depth, stored) {
+                    let against = stored;
+                    if depth_state.write {
+                        stored = eval.depth;
+                    }
+                    out.winner = Some(out.records.len());
+                    DepthOutcome::Passed { against }
+                } else {
+                    DepthOutcome::Failed { against: stored }
+                };
+                let block = block_containing(s, DEFAULT_BLOCK, x, y)
+                    .map_or(BlockClass::Outside, |r| classify_block(s, r));
+                out.records.push(ProbeRecord {
+                    triangle: p.triangle,
+                    piece: p.piece,
+                    clipped: p.clipped,
+                    setup: *s,
+                    eval,
+                    depth,
+                    block,
+                    varying: p.varyings(&eval, interpolation),
+                });
+            },
+        );
     }
     out.final_depth = stored;
     out

@@ -20,7 +20,7 @@ pub mod session;
 use std::sync::Arc;
 
 use config::{Access, ServeArgs};
-use server::{Admit, State};
+use server::{Admit, Limits, State};
 use session::Shared;
 
 use crate::tui::remote::RenderGate;
@@ -49,11 +49,13 @@ pub fn run(args: &ServeArgs) -> Result<(), ServeError> {
     let (key, made) = keys::host_key(&key_path)?;
     let scene = crate::cli::view_cmd::load(&args.model, crate::render::wire::Mode::Fill, false)?;
     let cores = std::thread::available_parallelism().map_or(2, std::num::NonZero::get);
+    let slots = args.render_slots.map_or(cores, |n| n as usize);
     let shared = Arc::new(Shared {
         scene: Arc::new(scene),
-        gate: Arc::new(RenderGate::new(cores)),
+        gate: Arc::new(RenderGate::new(slots)),
         fps: args.fps,
         idle: args.idle(),
+        stall: args.stall_timeout.max(std::time::Duration::from_secs(1)),
     });
     let who = match &access {
         Access::Public => "anyone (--public)".to_string(),
@@ -61,12 +63,13 @@ pub fn run(args: &ServeArgs) -> Result<(), ServeError> {
     };
     let fp = keys::fingerprint(key.public_key());
     let config = Arc::new(server::russh_config(key, admit_is_public(&admit)));
-    let state = Arc::new(State::new(
-        shared,
-        admit,
-        args.max_clients as usize,
-        args.max_per_address as usize,
-    ));
+    let limits = Limits {
+        max_clients: args.max_clients as usize,
+        max_per_address: args.max_per_address as usize,
+        startups: args.max_startups,
+        login_grace: args.login_grace_time.max(std::time::Duration::from_secs(1)),
+    };
+    let state = Arc::new(State::new(shared, admit, limits));
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(cores.min(4))
         .enable_all()

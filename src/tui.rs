@@ -16,6 +16,7 @@
 
 pub mod app;
 pub mod draw;
+pub mod gate;
 pub mod inspector;
 pub mod link;
 pub mod pacing;
@@ -320,8 +321,8 @@ struct Ctx<'a> {
     /// The process's own terminal: Ctrl-Z and job-control signals suspend and resume
     /// it. A remote terminal has no job control here.
     local: bool,
-    /// Shared by the viewers of one process, so their frames take turns at the CPU.
-    gate: Option<&'a remote::RenderGate>,
+    /// Shared by the viewers of one process, so their frames share the CPU by time.
+    gate: Option<gate::Seat<'a>>,
     /// Leave after this long without a key or mouse event.
     idle: Option<Duration>,
 }
@@ -332,7 +333,7 @@ fn draw<W: Write>(
     terminal: &mut Term<W>,
     pacer: &mut Pacer,
     bytes: &Cell<u64>,
-    gate: Option<&remote::RenderGate>,
+    gate: Option<gate::Seat<'_>>,
 ) -> io::Result<()> {
     let start_bytes = bytes.get();
     let size = terminal.size()?;
@@ -343,7 +344,7 @@ fn draw<W: Write>(
     let t0 = Instant::now();
     let mut render_time = Duration::ZERO;
     terminal.draw(|f| {
-        let _turn = gate.map(remote::RenderGate::enter);
+        let _turn = gate.map(gate::Seat::enter);
         let r = Instant::now();
         app.draw(f);
         render_time = r.elapsed();

@@ -98,6 +98,25 @@ pub fn probe_from<V: Varying>(
     y: u32,
     stored: f32,
 ) -> Probe<V> {
+    let mut projected = Vec::new();
+    project_vertices(cache, target, &mut projected);
+    probe_projected(cache, &projected, indices, target, opts, (x, y), stored)
+}
+
+/// [`probe_from`] with the vertices of `cache` already projected for `target`
+/// ([`project_vertices`]), as a caller probing many pixels of one frame keeps them.
+/// Each vertex projected once gives the set-ups the threaded renderer makes, and lets
+/// the many triangles whose box misses the pixel cost a box test.
+#[must_use]
+pub fn probe_projected<V: Varying>(
+    cache: &VertexCache<V>,
+    projected: &[Projected],
+    indices: &[u32],
+    target: Target,
+    opts: &DrawOptions,
+    (x, y): (u32, u32),
+    stored: f32,
+) -> Probe<V> {
     let (depth_state, interpolation) = (opts.depth, opts.interpolation);
     let mut out = Probe {
         x,
@@ -110,10 +129,6 @@ pub fn probe_from<V: Varying>(
         return out;
     }
     let mut stored = stored;
-    // Each vertex projected once, as the threaded renderer does (the same set-ups),
-    // so that the many triangles whose box misses the pixel cost a box test.
-    let mut projected = Vec::new();
-    project_vertices(cache, target, &mut projected);
     for (t, idx) in indices.chunks_exact(3).enumerate() {
         let get = |i: u32| projected.get(i as usize).copied();
         if let (Some(a), Some(b), Some(c)) = (get(idx[0]), get(idx[1]), get(idx[2]))
@@ -124,7 +139,7 @@ pub fn probe_from<V: Varying>(
         let t = t as u32;
         let _ = prepare_projected(
             cache,
-            Some(&projected),
+            Some(projected),
             indices,
             t,
             target,

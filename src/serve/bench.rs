@@ -27,7 +27,7 @@ pub struct BenchServeArgs {
     #[arg(default_value = "teapot")]
     pub model: String,
     /// Watchers reading as fast as the server sends.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=4096))]
     pub watchers: usize,
     /// Their terminal size.
     #[arg(long, default_value = "80x24", value_parser = parse_cells)]
@@ -61,6 +61,8 @@ struct Tally {
     /// Times of the answered queries (delivered frames).
     answers: Vec<Instant>,
     bytes: u64,
+    /// Why it ended before the benchmark did.
+    failed: Option<String>,
 }
 
 impl Tally {
@@ -179,7 +181,14 @@ fn start_server(args: &BenchServeArgs, dir: &std::path::Path) -> Result<(Child, 
     let n = (args.watchers + 2).to_string();
     let mut child = Command::new(std::env::current_exe()?)
         .args(["serve", &args.model, "--public", "--listen", "127.0.0.1:0"])
-        .args(["--max-clients", &n, "--max-per-address", &n])
+        .args([
+            "--max-clients",
+            &n,
+            "--max-per-address",
+            &n,
+            "--max-startups",
+            &n,
+        ])
         .args(["--fps", &args.fps.to_string(), "--host-key"])
         .arg(dir.join("host_key"))
         .stdin(Stdio::null())
@@ -224,10 +233,16 @@ pub fn run(args: &BenchServeArgs, out: &mut impl Write) -> Result<(), ServeError
     std::thread::sleep(Duration::from_millis(500));
     let rss0 = rss_kb(child.id());
     let stop = Arc::new(tokio::sync::Notify::new());
+    let size = args.size;
     let spawn = |rate: Option<u64>| {
         let tally = Arc::new(std::sync::Mutex::new(Tally::default()));
         let (t, s) = (Arc::clone(&tally), Arc::clone(&stop));
-        let task = rt.spawn(watch(port, args.size, rate, t, s));
+        let task = rt.spawn(async move {
+            let r = watch(port, size, rate, Arc::clone(&t), s).await;
+            if let Err(e) = r {
+                t.lock().unwrap_or_else(|e| e.into_inner()).failed = Some(e.to_string());
+            }
+        });
         (tally, task)
     };
     let fast: Vec<_> = (0..args.watchers).map(|_| spawn(None)).collect();
@@ -253,6 +268,13 @@ pub fn run(args: &BenchServeArgs, out: &mut impl Write) -> Result<(), ServeError
         args.fps
     )?;
     report(out, "each", &base)?;
+    let failed: Vec<String> = fast
+        .iter()
+        .filter_map(|(t, _)| t.lock().ok()?.failed.clone())
+        .collect();
+    if let Some(first) = failed.first() {
+        writeln!(out, "  {} watcher(s) failed: {first}", failed.len())?;
+    }
     let bytes: u64 = fast
         .iter()
         .map(|(t, _)| t.lock().map_or(0, |t| t.bytes))

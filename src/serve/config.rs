@@ -13,8 +13,11 @@ subsystems (sftp), port, agent and X11 forwarding are refused; a session without
 terminal is told so and closed. Nothing a client sends runs a program, opens a file
 or reaches the network. Who may watch: the keys in --authorized-keys (OpenSSH
 format), or anyone with --public; listening beyond loopback requires one of them
-(on loopback, neither means ~/.ssh/authorized_keys). Limits: --max-clients,
---max-per-address, 6 authentication attempts in 30 s, --idle-timeout.
+(on loopback, neither means ~/.ssh/authorized_keys). Limits: --max-clients
+watchers, --max-per-address, --max-startups unauthenticated connections (past
+it, new ones are dropped at random), 6 authentication attempts within
+--login-grace-time, --idle-timeout, --stall-timeout; watchers share
+--render-slots frames at once by rendering time.
 The host key (Ed25519) is made on first start, kept with mode 0600 (refused if
 others can read it); check its fingerprint, printed at start, on first connect.";
 
@@ -52,6 +55,71 @@ pub struct ServeArgs {
     /// Frame rate cap of each watcher.
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=240))]
     pub fps: u32,
+    /// Frames rendered at once for all watchers together (default: the cores); when
+    /// the CPU is short, watchers share them by rendering time.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub render_slots: Option<u32>,
+    /// Connections not yet authenticated, as OpenSSH's MaxStartups: past START of
+    /// them, new ones are dropped with probability RATE %, rising to every one at
+    /// FULL. They do not count against --max-clients.
+    #[arg(long, default_value = "10:30:60", value_name = "START:RATE:FULL", value_parser = Startups::parse)]
+    pub max_startups: Startups,
+    /// Time from connecting to being authenticated.
+    #[arg(long, default_value = "30s", value_parser = parse_duration)]
+    pub login_grace_time: Duration,
+    /// Close a session whose client has taken no output for this long.
+    #[arg(long, default_value = "30s", value_parser = parse_duration)]
+    pub stall_timeout: Duration,
+}
+
+/// The limit on connections not yet authenticated (see [`ServeArgs::max_startups`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Startups {
+    pub start: usize,
+    /// Percent.
+    pub rate: usize,
+    pub full: usize,
+}
+
+impl Startups {
+    /// Parses `START:RATE:FULL` (or a single number, as OpenSSH: drop all past it).
+    pub fn parse(s: &str) -> Result<Self, String> {
+        let bad = || format!("`{s}` is not START:RATE:FULL (e.g. 10:30:60) or a count");
+        let n: Vec<usize> = s
+            .split(':')
+            .map(|p| p.trim().parse().map_err(|_| bad()))
+            .collect::<Result<_, _>>()?;
+        let l = match n[..] {
+            [full] => Self {
+                start: full,
+                rate: 100,
+                full,
+            },
+            [start, rate, full] => Self { start, rate, full },
+            _ => return Err(bad()),
+        };
+        if l.full == 0 || l.start > l.full || l.rate > 100 || l.full > 100_000 {
+            return Err(format!(
+                "`{s}`: need 0 < START <= FULL <= 100000 and RATE <= 100"
+            ));
+        }
+        Ok(l)
+    }
+
+    /// Whether a new connection is dropped when `pending` are waiting to
+    /// authenticate, for a uniform `roll` in 0..100.
+    #[must_use]
+    pub fn drops(&self, pending: usize, roll: usize) -> bool {
+        if pending >= self.full {
+            return true;
+        }
+        if pending < self.start {
+            return false;
+        }
+        let chance =
+            self.rate + (100 - self.rate) * (pending - self.start) / (self.full - self.start);
+        roll < chance
+    }
 }
 
 /// Who may watch.
@@ -169,5 +237,20 @@ mod tests {
         assert_eq!(parse_duration("5"), Ok(Duration::from_secs(5)));
         assert!(parse_duration("5d").is_err() && parse_duration("m").is_err());
         assert_eq!(args(&["--idle-timeout", "0"]).idle(), None);
+    }
+
+    #[test]
+    fn startups_drop_more_as_more_wait() {
+        let l = Startups::parse("10:30:60").expect("parses");
+        assert_eq!(args(&[]).max_startups, l);
+        assert!((0..100).all(|roll| !l.drops(9, roll)), "below START none");
+        assert_eq!((0..100).filter(|&r| l.drops(10, r)).count(), 30);
+        assert_eq!((0..100).filter(|&r| l.drops(35, r)).count(), 65);
+        assert!((0..100).all(|roll| l.drops(60, roll)), "at FULL all");
+        let one = Startups::parse("5").expect("parses");
+        assert!(!one.drops(4, 99) && one.drops(5, 0));
+        for bad in ["", "1:2", "10:30:5", "0", "10:101:60", "a:b:c", "1:2:3:4"] {
+            assert!(Startups::parse(bad).is_err(), "{bad}");
+        }
     }
 }

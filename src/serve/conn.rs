@@ -6,7 +6,6 @@
 //! session) is refused, so nothing it sends runs a program, opens a file or opens a
 //! connection.
 
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use russh::server::{Auth, ChannelOpenHandle, Handler, Msg, Session};
@@ -14,7 +13,7 @@ use russh::{Channel, ChannelId, ChannelOpenFailure, ChannelWriteHalf};
 use tokio::sync::oneshot;
 
 use super::keys::fingerprint;
-use super::server::{Admit, State, lock};
+use super::server::{Admit, Phase, State, lock};
 use super::session::{self, Outcome, Request, Watcher};
 
 /// What a connection's log line says.
@@ -32,13 +31,17 @@ pub(super) struct Conn {
     pub(super) state: Arc<State>,
     /// Refused for this reason (too many watchers): told in the banner, never admitted.
     pub(super) refuse: Option<String>,
+    /// Authenticated when every watcher's place was taken: told this, then closed.
+    pub(super) full: Option<String>,
     pub(super) log: Arc<Mutex<Log>>,
-    pub(super) authed: Arc<AtomicBool>,
+    pub(super) phase: Arc<Mutex<Phase>>,
     pub(super) channel: Option<ChannelId>,
     pub(super) write: Option<ChannelWriteHalf<Msg>>,
     pub(super) req: Request,
     pub(super) watcher: Option<Watcher>,
     pub(super) done: Option<oneshot::Sender<Outcome>>,
+    /// Closes the connection outright (a stalled client).
+    pub(super) kill: Option<oneshot::Sender<()>>,
 }
 
 impl Conn {
@@ -48,8 +51,26 @@ impl Conn {
 
     fn accept(&mut self, key: String) -> Auth {
         lock(&self.log).key = Some(key);
-        self.authed.store(true, Ordering::Release);
+        if let Err(why) = self.state.authenticated(&self.phase) {
+            self.full = Some(why);
+        }
         Auth::Accept
+    }
+
+    /// Ends a session with one line of text instead of the viewer, logging `why`.
+    fn refuse_shell(
+        &self,
+        session: &mut Session,
+        channel: ChannelId,
+        why: &str,
+        text: &str,
+    ) -> Result<(), russh::Error> {
+        lock(&self.log).end = Some(format!("refused: {why}"));
+        session.channel_success(channel)?;
+        session.data(channel, format!("termrast: {text}\r\n").into_bytes())?;
+        session.exit_status_request(channel, 1)?;
+        session.eof(channel)?;
+        session.close(channel)
     }
 }
 
@@ -235,17 +256,18 @@ impl Handler for Conn {
         let Some(write) = self.write.take().filter(|_| self.ours(channel)) else {
             return session.channel_failure(channel);
         };
-        if self.req.pty.is_none() {
-            session.channel_success(channel)?;
-            lock(&self.log).end = Some("refused: no pty".into());
-            let text = "termrast: this server shows a 3D viewer and needs a terminal; \
-                        connect with `ssh -t`\r\n";
-            session.data(channel, text.as_bytes().to_vec())?;
-            session.exit_status_request(channel, 1)?;
-            session.eof(channel)?;
-            return session.close(channel);
+        if let Some(why) = &self.full {
+            return self.refuse_shell(session, channel, why, why);
         }
-        let done = self.done.take().expect("one shell per connection");
+        if self.req.pty.is_none() {
+            let text = "this server shows a 3D viewer and needs a terminal; \
+                        connect with `ssh -t`";
+            return self.refuse_shell(session, channel, "no pty", text);
+        }
+        // One shell per connection: `write` above is taken by the first.
+        let (Some(done), Some(kill)) = (self.done.take(), self.kill.take()) else {
+            return session.channel_failure(channel);
+        };
         match session::start(
             &self.state.shared,
             &self.req,
@@ -253,6 +275,7 @@ impl Handler for Conn {
             session.handle(),
             channel,
             done,
+            kill,
         ) {
             Ok(w) => {
                 lock(&self.state.watchers).insert(self.id, w.sender());

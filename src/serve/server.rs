@@ -4,8 +4,9 @@
 //! Each connection gets a [`super::conn::Conn`], russh's handler.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasher, RandomState};
 use std::net::{IpAddr, SocketAddr};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant, SystemTime};
 
@@ -15,12 +16,11 @@ use russh::{Disconnect, MethodKind};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::oneshot;
 
+use super::config::Startups;
 use super::conn::{Conn, Log};
 use super::keys::Authorized;
 use super::session::{Request, Shared};
 
-/// Time from connecting to being authenticated (as sshd's LoginGraceTime).
-pub const LOGIN_GRACE: Duration = Duration::from_secs(30);
 /// Authentication attempts per connection.
 pub const MAX_AUTH_ATTEMPTS: usize = 6;
 /// Connections being refused at once (with a message) before more are dropped
@@ -34,68 +34,152 @@ pub enum Admit {
     Public,
 }
 
+/// The limits a connection is admitted under.
+#[derive(Clone, Copy, Debug)]
+pub struct Limits {
+    /// Watchers (authenticated sessions) at once.
+    pub max_clients: usize,
+    /// Connections at once from one address, authenticated or not.
+    pub max_per_address: usize,
+    /// Connections not yet authenticated.
+    pub startups: Startups,
+    /// Time from connecting to being authenticated (as sshd's LoginGraceTime).
+    pub login_grace: Duration,
+}
+
+/// Where a connection stands, for the counts it holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Phase {
+    /// Admitted, not yet authenticated: holds a place among the startups.
+    Pending,
+    /// Authenticated and given a watcher's place.
+    Watching,
+    /// Authenticated when every watcher's place was taken: told so, then closed.
+    Full,
+}
+
+/// What became of a new connection.
+enum Arrival {
+    Admitted,
+    /// Told why in the banner, then closed.
+    Refused(String),
+    /// Closed at once, past the startups limit.
+    Dropped,
+}
+
+#[derive(Debug, Default)]
+struct Counts {
+    /// Admitted connections (any phase), by address.
+    by_address: HashMap<IpAddr, usize>,
+    pending: usize,
+    watching: usize,
+    /// Connections dropped since the last log line about them, and when it was.
+    dropped: u64,
+    dropped_said: Option<Instant>,
+}
+
 /// The server's state, shared by its connections.
 #[derive(Debug)]
 pub struct State {
     pub shared: Arc<Shared>,
     pub admit: Admit,
-    pub max_clients: usize,
-    pub max_per_address: usize,
-    /// Connections admitted (not refused), by address.
-    open: Mutex<HashMap<IpAddr, usize>>,
+    pub limits: Limits,
+    counts: Mutex<Counts>,
     refusing: Mutex<usize>,
     /// Running watchers, to end them on shutdown; and every connection's handle.
     pub(super) watchers: Mutex<HashMap<u64, std::sync::mpsc::SyncSender<crate::tui::Wake>>>,
     handles: Mutex<HashMap<u64, Handle>>,
     next_id: AtomicU64,
+    /// Draws the random early drops.
+    dice: RandomState,
 }
 
 impl State {
     #[must_use]
-    pub fn new(
-        shared: Arc<Shared>,
-        admit: Admit,
-        max_clients: usize,
-        max_per_address: usize,
-    ) -> Self {
+    pub fn new(shared: Arc<Shared>, admit: Admit, limits: Limits) -> Self {
         Self {
             shared,
             admit,
-            max_clients,
-            max_per_address,
-            open: Mutex::default(),
+            limits,
+            counts: Mutex::default(),
             refusing: Mutex::default(),
             watchers: Mutex::default(),
             handles: Mutex::default(),
             next_id: AtomicU64::new(0),
+            dice: RandomState::new(),
         }
     }
 
-    /// Admits a connection from `ip`, or says why not.
-    fn admit(&self, ip: IpAddr) -> Result<(), String> {
-        let mut open = lock(&self.open);
-        let total: usize = open.values().sum();
-        if total >= self.max_clients {
-            return Err(format!(
-                "{total} watchers already, the most this server takes; try again later"
-            ));
-        }
-        let here = open.entry(ip).or_insert(0);
-        if *here >= self.max_per_address {
-            return Err(format!(
+    /// Admits, refuses or drops a new connection from `ip`.
+    fn arrive(&self, ip: IpAddr, id: u64) -> Arrival {
+        let mut c = lock(&self.counts);
+        let here = c.by_address.get(&ip).copied().unwrap_or(0);
+        if here >= self.limits.max_per_address {
+            return Arrival::Refused(format!(
                 "{here} connections from {ip} already, the most it takes"
             ));
         }
-        *here += 1;
+        if c.watching >= self.limits.max_clients {
+            return Arrival::Refused(self.full_text(c.watching));
+        }
+        let roll = (self.dice.hash_one(id) % 100) as usize;
+        if self.limits.startups.drops(c.pending, roll) {
+            c.dropped += 1;
+            let now = Instant::now();
+            if c.dropped_said
+                .is_none_or(|t| now - t >= Duration::from_secs(1))
+            {
+                eprintln!(
+                    "{} dropped {} connection(s) past --max-startups ({} waiting to \
+                     authenticate)",
+                    utc(SystemTime::now()),
+                    c.dropped,
+                    c.pending
+                );
+                c.dropped = 0;
+                c.dropped_said = Some(now);
+            }
+            return Arrival::Dropped;
+        }
+        c.pending += 1;
+        *c.by_address.entry(ip).or_insert(0) += 1;
+        Arrival::Admitted
+    }
+
+    /// A pending connection has authenticated: gives it a watcher's place if one is
+    /// free, else says why not.
+    pub(super) fn authenticated(&self, phase: &Mutex<Phase>) -> Result<(), String> {
+        let mut c = lock(&self.counts);
+        let mut p = lock(phase);
+        if *p != Phase::Pending {
+            return Ok(());
+        }
+        c.pending -= 1;
+        if c.watching >= self.limits.max_clients {
+            *p = Phase::Full;
+            return Err(self.full_text(c.watching));
+        }
+        c.watching += 1;
+        *p = Phase::Watching;
         Ok(())
     }
 
-    fn release(&self, ip: IpAddr) {
-        let mut open = lock(&self.open);
-        if let Some(n) = open.get_mut(&ip) {
+    fn full_text(&self, watching: usize) -> String {
+        format!("{watching} watchers already, the most this server takes; try again later")
+    }
+
+    /// Gives back what an admitted connection held.
+    fn leave(&self, ip: IpAddr, phase: Phase) {
+        let mut c = lock(&self.counts);
+        match phase {
+            Phase::Pending => c.pending -= 1,
+            Phase::Watching => c.watching -= 1,
+            Phase::Full => {}
+        }
+        if let Some(n) = c.by_address.get_mut(&ip) {
             *n -= 1;
             if *n == 0 {
-                open.remove(&ip);
+                c.by_address.remove(&ip);
             }
         }
     }
@@ -183,9 +267,21 @@ async fn connection(
 ) {
     let start = Instant::now();
     let when = SystemTime::now();
-    let refuse = match state.admit(peer.ip()) {
-        Ok(()) => None,
-        Err(why) => {
+    // A second handle on the socket, to shut it down under a session stuck writing
+    // to a client that reads nothing (dropping the session would leave its task
+    // running, and its handle's calls wait on that stuck loop).
+    let (sock, closer) = match split_closer(sock) {
+        Ok(pair) => pair,
+        Err(e) => {
+            eprintln!("{} {peer} end=error: {e}", utc(when));
+            return;
+        }
+    };
+    let id = state.next_id.fetch_add(1, Ordering::Relaxed);
+    let refuse = match state.arrive(peer.ip(), id) {
+        Arrival::Admitted => None,
+        Arrival::Dropped => return,
+        Arrival::Refused(why) => {
             let mut n = lock(&state.refusing);
             if *n >= MAX_REFUSING {
                 return;
@@ -197,32 +293,35 @@ async fn connection(
     // Frames end in a small query: without this, Nagle holds it for the ACK of the
     // frame, and every frame waits a delayed ACK (run_stream does not set it).
     let _ = sock.set_nodelay(true);
-    let id = state.next_id.fetch_add(1, Ordering::Relaxed);
     let log = Arc::new(Mutex::new(Log::default()));
-    let authed = Arc::new(AtomicBool::new(false));
+    let phase = Arc::new(Mutex::new(Phase::Pending));
     let (done_tx, done_rx) = oneshot::channel();
+    let (kill_tx, kill_rx) = oneshot::channel::<()>();
     let conn = Conn {
         id,
         state: Arc::clone(&state),
         refuse: refuse.clone(),
+        full: None,
         log: Arc::clone(&log),
-        authed: Arc::clone(&authed),
+        phase: Arc::clone(&phase),
         channel: None,
         write: None,
         req: Request::default(),
         watcher: None,
         done: Some(done_tx),
+        kill: Some(kill_tx),
     };
-    let result =
-        tokio::time::timeout(LOGIN_GRACE, russh::server::run_stream(config, sock, conn)).await;
+    let grace = state.limits.login_grace;
+    let result = tokio::time::timeout(grace, russh::server::run_stream(config, sock, conn)).await;
     match result {
         Ok(Ok(running)) => {
             let handle = running.handle();
             lock(&state.handles).insert(id, handle.clone());
             // Authenticate within the grace time, or go.
+            let phase = Arc::clone(&phase);
             let grace = tokio::spawn(async move {
-                tokio::time::sleep(LOGIN_GRACE).await;
-                if !authed.load(Ordering::Acquire) {
+                tokio::time::sleep(grace).await;
+                if *lock(&phase) == Phase::Pending {
                     let _ = handle
                         .disconnect(
                             Disconnect::ByApplication,
@@ -232,7 +331,21 @@ async fn connection(
                         .await;
                 }
             });
-            let r = running.await;
+            // A stalled watcher's kill shuts the socket down: the session's reads
+            // see its end and its writes fail, so it ends by itself.
+            let killed = async {
+                if kill_rx.await.is_err() {
+                    std::future::pending::<()>().await;
+                }
+            };
+            tokio::pin!(running);
+            let r = tokio::select! {
+                r = &mut running => r,
+                () = killed => {
+                    let _ = closer.shutdown(std::net::Shutdown::Both);
+                    running.await
+                }
+            };
             grace.abort();
             if let Err(e) = r {
                 let mut l = lock(&log);
@@ -262,7 +375,7 @@ async fn connection(
             *lock(&state.refusing) -= 1;
             lock(&log).end = Some(format!("refused: {why}"));
         }
-        None => state.release(peer.ip()),
+        None => state.leave(peer.ip(), *lock(&phase)),
     }
     let l = lock(&log);
     let end = l.end.clone().unwrap_or_else(|| {
@@ -282,6 +395,13 @@ async fn connection(
     );
     // Last: shutdown waits for this, so the line above is never lost.
     lock(&state.handles).remove(&id);
+}
+
+/// The socket for the session, and a clone of it that can shut it down.
+fn split_closer(sock: TcpStream) -> std::io::Result<(TcpStream, std::net::TcpStream)> {
+    let std_sock = sock.into_std()?;
+    let closer = std_sock.try_clone()?;
+    Ok((TcpStream::from_std(std_sock)?, closer))
 }
 
 /// `2026-12-03T10:52:35Z`.

@@ -10,7 +10,7 @@
 //! terminal's answers ([`crate::tui::pacing`]); each frame is handed to an async task
 //! through a one-frame queue, and that task writes it within the client's SSH
 //! window. A client that stops reading therefore stalls only its own viewer, which
-//! holds at most a frame or two, and is dropped after [`STALL`]. Input is bounded
+//! holds at most a frame or two, and is dropped after [`Shared::stall`]. Input is bounded
 //! the same way: at most [`INPUT_QUEUE`] reads wait for the viewer, and the rest of
 //! a flood is dropped.
 
@@ -34,8 +34,6 @@ use crate::tui::{RunOptions, ViewError, Wake};
 
 /// Reads of input that may wait for the viewer; a flood beyond is dropped.
 pub const INPUT_QUEUE: usize = 32;
-/// How long a frame may wait for the client to take it before the session is closed.
-pub const STALL: Duration = Duration::from_secs(30);
 /// The largest terminal served, in cells: a bigger one is drawn in this much of it
 /// (each watcher's frame buffers grow with its size).
 pub const MAX_COLS: u16 = 400;
@@ -57,6 +55,9 @@ pub struct Shared {
     pub gate: Arc<RenderGate>,
     pub fps: u32,
     pub idle: Option<Duration>,
+    /// How long a frame may wait for the client to take it before the session is
+    /// closed.
+    pub stall: Duration,
 }
 
 /// What a client asked for its session before the shell.
@@ -121,8 +122,8 @@ pub enum End {
     Idle(Duration),
     /// The server is stopping.
     Shutdown,
-    /// The client took no output for [`STALL`].
-    Stalled,
+    /// The client took no output for this long.
+    Stalled(Duration),
     /// Its terminal cannot show the viewer.
     Unsupported(String),
     Error(String),
@@ -135,7 +136,7 @@ impl std::fmt::Display for End {
             End::Gone => write!(f, "client closed"),
             End::Idle(d) => write!(f, "idle {}s", d.as_secs()),
             End::Shutdown => write!(f, "server stopping"),
-            End::Stalled => write!(f, "stalled (read nothing for {}s)", STALL.as_secs()),
+            End::Stalled(d) => write!(f, "stalled (read nothing for {}s)", d.as_secs()),
             End::Unsupported(w) => write!(f, "unsupported terminal: {w}"),
             End::Error(e) => write!(f, "error: {e}"),
         }
@@ -147,7 +148,7 @@ impl End {
     #[must_use]
     pub fn farewell(&self) -> Option<String> {
         match self {
-            End::Quit | End::Gone | End::Stalled | End::Error(_) => None,
+            End::Quit | End::Gone | End::Stalled(_) | End::Error(_) => None,
             End::Idle(d) => Some(format!(
                 "termrast: closed after {} s without a key",
                 d.as_secs()
@@ -219,6 +220,7 @@ pub fn start(
     handle: Handle,
     id: ChannelId,
     done: oneshot::Sender<Outcome>,
+    kill: oneshot::Sender<()>,
 ) -> io::Result<Watcher> {
     let (wake_tx, wake_rx) = mpsc::sync_channel(INPUT_QUEUE);
     let (out_tx, mut out_rx) = tokio::sync::mpsc::channel::<Vec<u8>>(1);
@@ -264,13 +266,14 @@ pub fn start(
             };
             let _ = view_tx.send(outcome);
         })?;
+    let stall = shared.stall;
     tokio::spawn(async move {
         // Frames to the client, within its window; a frame it leaves waiting for
-        // STALL ends the session.
+        // `stall` ends the session.
         let mut w = write.make_writer();
         let mut stalled = false;
         while let Some(buf) = out_rx.recv().await {
-            match tokio::time::timeout(STALL, w.write_all(&buf)).await {
+            match tokio::time::timeout(stall, w.write_all(&buf)).await {
                 Ok(Ok(())) => {}
                 Ok(Err(_)) => break,
                 Err(_) => {
@@ -281,11 +284,15 @@ pub fn start(
         }
         // Unblocks the viewer if it is still writing.
         drop(out_rx);
-        let (mut end, bytes) = view_rx
+        let (end, bytes) = view_rx
             .await
             .unwrap_or((End::Error("the viewer panicked".into()), 0));
         if stalled {
-            end = End::Stalled;
+            // Nothing more reaches a client that takes nothing, and the connection's
+            // queue to it is full: it is closed outright.
+            let _ = done.send((End::Stalled(stall), bytes));
+            let _ = kill.send(());
+            return;
         }
         if let Some(text) = end.farewell() {
             let _ = handle.data(id, format!("{text}\r\n").into_bytes()).await;

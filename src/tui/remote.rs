@@ -3,13 +3,12 @@
 //! channel, say). The frame loop, pacing and cell cache are the local viewer's; what
 //! differs is that nothing here touches the process's terminal, signals or job
 //! control, and that viewers sharing a process take turns rendering
-//! ([`RenderGate`]).
+//! ([`RenderGate`], each viewer with its own [`Account`]).
 
 use std::cell::Cell;
 use std::io::{self, Write};
 use std::rc::Rc;
 use std::sync::mpsc;
-use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
 use ratatui::Terminal;
@@ -18,54 +17,11 @@ use ratatui::crossterm::terminal::{EnterAlternateScreen, LeaveAlternateScreen};
 use ratatui::crossterm::{cursor, execute};
 
 use super::app::App;
+pub use super::gate::RenderGate;
+use super::gate::{Account, Seat};
 use super::pacing::Pacer;
 use super::{Counting, Ctx, RunOptions, ViewError, Wake, link, main_loop, settle};
 use crate::terminal::input::Parser;
-
-/// At most `n` frames render at once, admitted in the order they asked: with many
-/// viewers in one process each gets an equal share of frames when the CPU is short,
-/// and none can starve the others by asking more often.
-#[derive(Debug)]
-pub struct RenderGate {
-    /// Next ticket to hand out, and tickets below which may render.
-    state: Mutex<(u64, u64)>,
-    turn: Condvar,
-}
-
-/// A frame's turn at the CPU; the next waiting frame goes when it is dropped.
-#[derive(Debug)]
-pub struct Turn<'a>(&'a RenderGate);
-
-impl RenderGate {
-    /// A gate letting `n` frames render at once (at least one).
-    #[must_use]
-    pub fn new(n: usize) -> Self {
-        Self {
-            state: Mutex::new((0, n.max(1) as u64)),
-            turn: Condvar::new(),
-        }
-    }
-
-    /// Waits for this frame's turn.
-    pub fn enter(&self) -> Turn<'_> {
-        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        let ticket = s.0;
-        s.0 += 1;
-        while ticket >= s.1 {
-            s = self.turn.wait(s).unwrap_or_else(|e| e.into_inner());
-        }
-        Turn(self)
-    }
-}
-
-impl Drop for Turn<'_> {
-    fn drop(&mut self) {
-        let mut s = self.0.state.lock().unwrap_or_else(|e| e.into_inner());
-        s.1 += 1;
-        drop(s);
-        self.0.turn.notify_all();
-    }
-}
 
 /// A terminal at the far end of a channel.
 #[derive(Debug)]
@@ -122,6 +78,7 @@ fn run_counted<W: Write>(
             .write_all(&crate::terminal::palette::query())?;
     }
     app.fps.cap = options.fps.max(1) as f32;
+    let account = Account::default();
     let mut pacer = Pacer::new(options.paced, options.max_rate);
     let mut parser = Parser::default();
     let result = main_loop(
@@ -134,7 +91,10 @@ fn run_counted<W: Write>(
             pacer: &mut pacer,
             bytes,
             local: false,
-            gate: remote.gate,
+            gate: remote.gate.map(|gate| Seat {
+                gate,
+                account: &account,
+            }),
             idle: remote.idle,
         },
     );
@@ -150,37 +110,4 @@ fn run_counted<W: Write>(
         cursor::Show
     );
     result.and(restored.map_err(ViewError::from))
-}
-
-#[cfg(test)]
-mod tests {
-    use std::sync::Arc;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-
-    use super::*;
-
-    /// No more than `n` turns at once, however many threads ask.
-    #[test]
-    fn the_gate_admits_n_at_once() {
-        let gate = Arc::new(RenderGate::new(2));
-        let (inside, most) = (Arc::new(AtomicUsize::new(0)), Arc::new(AtomicUsize::new(0)));
-        let threads: Vec<_> = (0..6)
-            .map(|_| {
-                let (gate, inside, most) = (gate.clone(), inside.clone(), most.clone());
-                std::thread::spawn(move || {
-                    for _ in 0..50 {
-                        let _t = gate.enter();
-                        let k = inside.fetch_add(1, Ordering::SeqCst) + 1;
-                        most.fetch_max(k, Ordering::SeqCst);
-                        std::thread::yield_now();
-                        inside.fetch_sub(1, Ordering::SeqCst);
-                    }
-                })
-            })
-            .collect();
-        for t in threads {
-            t.join().expect("no panic");
-        }
-        assert!(most.load(Ordering::SeqCst) <= 2);
-    }
 }

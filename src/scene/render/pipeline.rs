@@ -2,6 +2,7 @@
 //! else the packed shader at the narrowest width that holds its varyings), its vertex
 //! cache, and what it draws (fill, wireframe, silhouettes, the probe).
 
+use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3, Vec4};
@@ -11,13 +12,16 @@ use crate::counters::{self, Stage};
 use crate::raster::Target;
 use crate::raster::depth::{DepthBuffer, DepthState};
 use crate::raster::interp::Varying;
-use crate::render::probe::{DepthOutcome, Probe, probe_from};
+use crate::render::probe::{DepthOutcome, Probe, probe_projected};
 
 use crate::render::wire::{
     LineHit, ScreenLine, WIRE_COLOR, WIRE_DEPTH_BIAS, WireCount, draw_wireframe, line_under,
     probe_lines, project_edge,
 };
-use crate::render::{Cull, DrawOptions, Renderer, Rgba8, Shader, VertexCache, ndc_to_screen};
+use crate::render::{
+    Cull, DrawOptions, Projected, Renderer, Rgba8, Shader, VertexCache, ndc_to_screen,
+    project_vertices,
+};
 use crate::scene::plan::{ObjectPlan, VaryingSet};
 use crate::scene::{LightDesc, SceneObject};
 
@@ -152,6 +156,9 @@ impl<const K: usize> Shading for Packed<K> {
 struct Pipeline<S: Shading> {
     cache: VertexCache<S::Varying>,
     varyings: VaryingSet,
+    /// The cache's vertices projected for the probe, and the target they are for:
+    /// made by the first probe after a draw, kept for the frame's other probes.
+    projected: Mutex<(Option<Target>, Vec<Projected>)>,
 }
 
 impl<S: Shading> ObjectPipeline for Pipeline<S> {
@@ -167,6 +174,10 @@ impl<S: Shading> ObjectPipeline for Pipeline<S> {
         let start = Instant::now();
         let shader = S::shader(obj, plan, ctx);
         r.transform(&shader, obj.mesh.positions.len(), &mut self.cache);
+        self.projected
+            .get_mut()
+            .unwrap_or_else(PoisonError::into_inner)
+            .0 = None;
         let vertex = start.elapsed();
         if plan.fill {
             let shaded = r.stats.shaded;
@@ -274,7 +285,25 @@ impl<S: Shading> ObjectPipeline for Pipeline<S> {
                 final_depth: stored,
             };
         }
-        let p = probe_from(&self.cache, &obj.mesh.indices, target, opts, x, y, stored);
+        let mut projected = self
+            .projected
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        if projected.0 != Some(target) {
+            project_vertices(&self.cache, target, &mut projected.1);
+            projected.0 = Some(target);
+        }
+        let indices = &obj.mesh.indices;
+        let p = probe_projected(
+            &self.cache,
+            &projected.1,
+            indices,
+            target,
+            opts,
+            (x, y),
+            stored,
+        );
+        drop(projected);
         // The trait object cannot return this pipeline's varying type: each record
         // keeps the colour shaded from it instead.
         let shader = S::shader(obj, plan, ctx);
@@ -352,6 +381,7 @@ pub fn pipeline_for(
         Box::new(Pipeline::<S> {
             cache: VertexCache::default(),
             varyings,
+            projected: Mutex::default(),
         })
     }
     let varyings = plan.varyings;

@@ -316,6 +316,13 @@ impl Parser {
         None
     }
 
+    /// Bytes held for a sequence whose end has not arrived (at most
+    /// [`MAX_SEQUENCE`] once [`Parser::next`] has returned `None`).
+    #[must_use]
+    pub fn pending(&self) -> usize {
+        self.buf.len()
+    }
+
     /// When pending incomplete input resolves on its own (a lone ESC becomes the Esc
     /// key, a broken sequence is dropped), if any is pending.
     #[must_use]

@@ -15,6 +15,7 @@ mod framing;
 mod gltf;
 mod glyphs;
 mod hard_cases;
+mod input;
 mod lines;
 mod link;
 mod mesh;

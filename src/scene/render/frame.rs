@@ -314,7 +314,10 @@ impl SceneFrame {
         );
         for i in order {
             let op = &scene.plan.objects[i];
-            let triangle = probes[i].winner.map(|w| probes[i].records[w].triangle);
+            // No probes before the first frame (or after a change of mode).
+            let triangle = probes
+                .get(i)
+                .and_then(|p| p.winner.map(|w| p.records[w].triangle));
             let wires = op.wireframe.then(|| depth.filter(|_| op.hidden_lines));
             let found = self.pipelines[i].line_under(
                 &scene.objects[i],

@@ -422,12 +422,15 @@ fn main_loop<W: Write>(
             app.frame_drawn(now);
             next_frame = now + period;
             dirty = false;
-            continue;
+        } else {
+            if !app.paused {
+                app.tick(now - last);
+            }
+            last = now;
         }
-        if !app.paused {
-            app.tick(now - last);
-        }
-        last = now;
+        // Input is read between any two frames: a frame that takes longer than the
+        // period (a huge model, a busy machine) must not keep the keys from the viewer.
+        let now = Instant::now();
         // Sleep until the next frame is due (or what holds it, the pacer, may let it
         // go), a pending escape resolves, or input or a signal arrives.
         let idle_at = idle.map(|d| last_input + d);

@@ -35,3 +35,37 @@ proptest! {
         prop_assert!(out.ends_with(b"\x1b[?25h"), "screen not restored");
     }
 }
+
+/// A viewer whose every frame takes longer than its period still reads its keys:
+/// `q` queued behind the first frame ends the session.
+#[test]
+fn keys_are_read_when_frames_overrun_their_period() {
+    let scene = termrast::scene::Scene::for_model("teapot").unwrap();
+    let app = App::new(scene, termrast::tui::viewport::ViewSettings::default());
+    let (tx, rx) = std::sync::mpsc::sync_channel(4);
+    tx.send(Wake::Bytes(b"q".to_vec())).unwrap();
+    let (done_tx, done_rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let gate = RenderGate::new(1);
+        let mut out = Vec::new();
+        // A period of 0.1 ms: no frame is drawn within it.
+        let options = RunOptions {
+            fps: 10_000,
+            max_rate: None,
+            paced: false,
+            ask_palette: false,
+        };
+        let remote = Remote {
+            out: &mut out,
+            cols: 120,
+            rows: 40,
+            wakes: rx,
+            gate: Some(&gate),
+            idle: None,
+        };
+        let _ = done_tx.send(remote::run(app, options, remote).0.is_ok());
+        drop(tx);
+    });
+    let ended = done_rx.recv_timeout(std::time::Duration::from_secs(30));
+    assert_eq!(ended, Ok(true), "q was not read while frames kept coming");
+}

@@ -189,6 +189,9 @@ pub struct UvShader<'a> {
 }
 
 impl Shader for UvShader<'_> {
+    /// The accuracy table measures one thread.
+    const THREADED: bool = false;
+
     type Varying = Vec2;
     #[inline(always)]
     fn vertex(&self, i: u32) -> (Vec4, Vec2) {

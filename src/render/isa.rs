@@ -121,6 +121,9 @@ impl DrawCopy {
             _ => Isa::Baseline,
         };
         let variant = match variant {
+            // On x86_64 the baseline copy serves only CPUs without AVX2, and is built
+            // for `Generic` alone: half the draw loop's machine code was baseline.
+            _ if isa == Isa::Baseline && cfg!(target_arch = "x86_64") => Variant::Generic,
             Variant::Fast if isa != Isa::Avx512 => Variant::Standard,
             v => v,
         };
@@ -140,7 +143,9 @@ pub(super) fn run<S: Shader, C: ColorTarget>(
     opts: &DrawOptions,
     color: &mut C,
 ) {
-    if r.threaded() {
+    // `S::THREADED` first, as its own condition: a constant `false` keeps the threaded
+    // copies from being compiled for the shader.
+    if S::THREADED && r.threaded() {
         run_tiled(copy, r, shader, cache, indices, opts, color);
         return;
     }
@@ -168,6 +173,9 @@ pub(super) fn run<S: Shader, C: ColorTarget>(
             return;
         }
     }
+    #[cfg(target_arch = "x86_64")]
+    baseline::draw::<Generic, _, _>(r, shader, cache, indices, opts, color);
+    #[cfg(not(target_arch = "x86_64"))]
     match copy.variant {
         Variant::Generic => baseline::draw::<Generic, _, _>(r, shader, cache, indices, opts, color),
         Variant::Standard | Variant::Fast => {
@@ -212,6 +220,12 @@ fn run_tiled<S: Shader, C: ColorTarget>(
         }
     }
     // SAFETY: the baseline copy runs on every CPU.
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        tiles::draw::<baseline::Tiled<Generic>, _, _>(r, shader, cache, indices, opts, color);
+    }
+    // SAFETY: as above.
+    #[cfg(not(target_arch = "x86_64"))]
     unsafe {
         match copy.variant {
             Variant::Generic => {

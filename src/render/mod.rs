@@ -30,7 +30,7 @@
 //! | variant \ ISA | baseline | AVX2 | AVX-512 |
 //! |---|---|---|---|
 //! | [`Generic`]: reads every option | yes | yes | no: runs AVX2 |
-//! | [`Standard`]: depth `Less` + write, perspective are constants | yes | yes | no: runs AVX2 |
+//! | [`Standard`]: depth `Less` + write, perspective are constants | off x86_64 (there: runs `Generic`) | yes | no: runs AVX2 |
 //! | [`Fast`]: `Standard` with the `wide` traversal | no: runs `Standard` | no: runs `Standard` | lane-code shaders, targets ≥ 8 px wide |
 //!
 //! Why: `Standard` is the viewer's and the benchmark's state, so its per-group code
@@ -38,7 +38,8 @@
 //! shaders with lane code of their own ([`Shader::LANE_CODE`]) on the `wide` traversal,
 //! and only on targets at least 8 pixels wide (its two-row groups then never need the
 //! per-pixel fallback), so it is built for `Fast` alone; a third copy of every variant
-//! would mostly lengthen the build. The `Fast` copy's call sits behind the constant
+//! would mostly lengthen the build. On x86_64 the baseline copy serves only CPUs
+//! without AVX2, so it is built for `Generic` alone. The `Fast` copy's call sits behind the constant
 //! `S::LANE_CODE`, so it is not even compiled for other shaders. No call may sit in a
 //! group loop, taken or not: every vector register is lost across it.
 
@@ -294,7 +295,7 @@ impl Renderer {
             self.depth.reset(self.target.width, self.target.height);
         }
         let work = self.target.len() as u64 + TRIANGLE_WORK * (indices.len() / 3) as u64;
-        self.threaded = self.tiled() && work >= self.min_threaded_work;
+        self.threaded = S::THREADED && self.tiled() && work >= self.min_threaded_work;
         if !self.threaded {
             self.finish_clear(color);
         }

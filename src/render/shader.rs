@@ -25,6 +25,12 @@ pub trait Shader: Sync {
     /// from wider lanes, and only makes the build longer.
     const LANE_CODE: bool = false;
 
+    /// Whether draws of this shader may run on the renderer's threads. A shader only
+    /// ever drawn on one thread (the accuracy table's, which measures one thread's
+    /// cost) says `false`, so the threaded copies of the draw loop are not compiled for
+    /// it; a renderer with threads then draws it on the calling thread.
+    const THREADED: bool = true;
+
     /// Colours of a group of fragments of one triangle at once (8 lanes per row of
     /// pixels, `F::ROWS` rows): lane `k` (for each set bit of `mask`) has weights
     /// `w[..][k]` for the triangle's varyings in relative form `rel` (see

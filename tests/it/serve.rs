@@ -479,7 +479,7 @@ fn unauthenticated_connections_are_bounded_apart_from_watchers() {
     if !tools(true, "startups") {
         return;
     }
-    let (_dir, key, mut server) = keyed(
+    let (dir, key, mut server) = keyed(
         "startups",
         &[
             "--max-clients",
@@ -499,7 +499,9 @@ fn unauthenticated_connections_are_bounded_apart_from_watchers() {
             s
         })
         .collect();
-    // One who connects now but authenticates only after 5 s (its bytes held back).
+    // One who connects now but authenticates only once `go` exists (its bytes are
+    // held back until then).
+    let go = dir.join("go");
     let late = Command::new("timeout")
         .args(["60", "sh", "-c"])
         .arg(format!(
@@ -508,8 +510,9 @@ fn unauthenticated_connections_are_bounded_apart_from_watchers() {
                 Some(&key),
                 &format!(
                     "-T -o ProxyCommand=\"bash -c 'exec 3<>/dev/tcp/127.0.0.1/{} 4<&0; \
-                     (sleep 5; cat <&4) >&3 & cat <&3'\"",
-                    server.port
+                     (until [ -e {} ]; do sleep 0.05; done; cat <&4) >&3 & cat <&3'\"",
+                    server.port,
+                    go.display()
                 )
             )
         ))
@@ -521,6 +524,7 @@ fn unauthenticated_connections_are_bounded_apart_from_watchers() {
     t.open("w", 80, 24, &server.ssh(Some(&key), "-t"));
     t.watching("w");
     // The late one authenticates with every place taken: told so in its session.
+    std::fs::write(&go, "").expect("go");
     let out = late.wait_with_output().expect("ssh");
     let out = String::from_utf8_lossy(&out.stdout);
     assert!(out.contains("termrast: 1 watchers already"), "{out}");

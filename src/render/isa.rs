@@ -122,7 +122,7 @@ impl DrawCopy {
         };
         let variant = match variant {
             // On x86_64 the baseline copy serves only CPUs without AVX2, and is built
-            // for `Generic` alone: half the draw loop's machine code was baseline.
+            // for `Generic` alone, which keeps the build short.
             _ if isa == Isa::Baseline && cfg!(target_arch = "x86_64") => Variant::Generic,
             Variant::Fast if isa != Isa::Avx512 => Variant::Standard,
             v => v,

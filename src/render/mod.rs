@@ -39,9 +39,10 @@
 //! and only on targets at least 8 pixels wide (its two-row groups then never need the
 //! per-pixel fallback), so it is built for `Fast` alone; a third copy of every variant
 //! would mostly lengthen the build. On x86_64 the baseline copy serves only CPUs
-//! without AVX2, so it is built for `Generic` alone. The `Fast` copy's call sits behind the constant
-//! `S::LANE_CODE`, so it is not even compiled for other shaders. No call may sit in a
-//! group loop, taken or not: every vector register is lost across it.
+//! without AVX2, so it is built for `Generic` alone. The `Fast` copy's call sits
+//! behind the constant `S::LANE_CODE`, so it is not even compiled for other shaders.
+//! No call may sit in a group loop, taken or not: every vector register is lost
+//! across it.
 
 pub mod eval;
 mod fragments;

@@ -314,7 +314,7 @@ impl SceneFrame {
         );
         for i in order {
             let op = &scene.plan.objects[i];
-            // No probes before the first frame (or after a change of mode).
+            // No probes before the first frame.
             let triangle = probes
                 .get(i)
                 .and_then(|p| p.winner.map(|w| p.records[w].triangle));

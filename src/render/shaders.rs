@@ -65,6 +65,33 @@ impl<'a> Lambert<'a> {
     }
 }
 
+impl Lambert<'_> {
+    /// The lit cosine `max(n·L / |n|, 0)` of an interpolated normal (shorter than 1:
+    /// it is normalised here). Written out, with fused multiply-adds, so
+    /// [`Lambert::cosine_lanes`] repeats it bit for bit.
+    #[inline(always)]
+    fn cosine(&self, n: Vec3) -> f32 {
+        let lt = self.light;
+        let len = n.z.mul_add(n.z, n.y.mul_add(n.y, n.x * n.x)).sqrt();
+        let d = n.z.mul_add(lt.z, n.y.mul_add(lt.y, n.x * lt.x));
+        let l = d / len;
+        if l > 0.0 { l } else { 0.0 }
+    }
+
+    /// [`Lambert::cosine`] on lanes of the normal's components.
+    #[inline(always)]
+    fn cosine_lanes<F: F32s>(&self, [x, y, z]: [F; 3]) -> F {
+        let len = z.mul_add(z, y.mul_add(y, x * x)).sqrt();
+        let lt = self.light;
+        let d = z.mul_add(
+            F::splat(lt.z),
+            y.mul_add(F::splat(lt.y), x * F::splat(lt.x)),
+        );
+        // NaN (zero-length normal) compares false and becomes 0, as in `cosine`.
+        (d / len).max(F::splat(0.0))
+    }
+}
+
 impl Shader for Lambert<'_> {
     type Varying = Direction;
     const LANE_CODE: bool = true;
@@ -79,15 +106,7 @@ impl Shader for Lambert<'_> {
 
     #[inline(always)]
     fn fragment(&self, &Direction(n): &Direction) -> Vec3 {
-        // Normalise after interpolation (interpolated unit vectors are shorter than 1):
-        // l = max(n·L / |n|, 0). Written out, with fused multiply-adds, so `fragment_lanes`
-        // can repeat it bit for bit.
-        let lt = self.light;
-        let len = n.z.mul_add(n.z, n.y.mul_add(n.y, n.x * n.x)).sqrt();
-        let d = n.z.mul_add(lt.z, n.y.mul_add(lt.y, n.x * lt.x));
-        let l = d / len;
-        let l = if l > 0.0 { l } else { 0.0 };
-        Vec3::splat(l).mul_add(self.lit, self.unlit)
+        Vec3::splat(self.cosine(n)).mul_add(self.lit, self.unlit)
     }
 
     #[inline(always)]
@@ -99,18 +118,10 @@ impl Shader for Lambert<'_> {
     ) -> ShadeLanes<F> {
         // `Direction::from_relative` lane by lane: a·w0 + b·w1 + c·w2, fused.
         let [a, b, c] = [rel[0].0, rel[1].0, rel[2].0];
-        let [x, y, z] =
+        let n =
             each3!(|i| F::splat(c[i])
                 .mul_add(w[2], F::splat(b[i]).mul_add(w[1], F::splat(a[i]) * w[0])));
-        let len = z.mul_add(z, y.mul_add(y, x * x)).sqrt();
-        let lt = self.light;
-        let d = z.mul_add(
-            F::splat(lt.z),
-            y.mul_add(F::splat(lt.y), x * F::splat(lt.x)),
-        );
-        let l = d / len;
-        // NaN (zero-length normal) compares false and becomes 0, as in `fragment`.
-        let l = l.max(F::splat(0.0));
+        let l = self.cosine_lanes(n);
         let (lit, unlit) = (self.lit, self.unlit);
         // A grey base (the standard scene's white) gives three equal channels: one
         // multiply-add and, in the target, one conversion.
@@ -122,13 +133,60 @@ impl Shader for Lambert<'_> {
     }
 }
 
+/// [`Lambert`] times the mesh's vertex colours (a scan's, a painted asset's):
+/// `colour·(l·lit + unlit)`, with lane code of its own. Varying: the world-space
+/// normal and the vertex colour, both perspective-correct (the colour needs the
+/// division, so the normal takes the same weights rather than its projective form).
+#[derive(Clone, Debug)]
+pub struct ColoredLambert<'a>(pub Lambert<'a>);
+
+impl Shader for ColoredLambert<'_> {
+    type Varying = (Vec3, Vec3);
+    const LANE_CODE: bool = true;
+
+    #[inline(always)]
+    fn vertex(&self, index: u32) -> (Vec4, (Vec3, Vec3)) {
+        let (pos, Direction(n)) = self.0.vertex(index);
+        let c = self.0.mesh.colors.get(index as usize).copied();
+        (pos, (n, c.unwrap_or(Vec3::ONE)))
+    }
+
+    #[inline(always)]
+    fn fragment(&self, &(n, c): &(Vec3, Vec3)) -> Vec3 {
+        let s = &self.0;
+        Vec3::splat(s.cosine(n)).mul_add(s.lit, s.unlit) * c
+    }
+
+    #[inline(always)]
+    fn fragment_lanes<F: F32s>(
+        &self,
+        rel: &[(Vec3, Vec3); 3],
+        w: &[F; 3],
+        _mask: u32,
+    ) -> ShadeLanes<F> {
+        let n = relative_lanes([rel[0].0, rel[1].0, rel[2].0], w);
+        let c = relative_lanes([rel[0].1, rel[1].1, rel[2].1], w);
+        let s = &self.0;
+        let l = s.cosine_lanes(n);
+        ShadeLanes::Rgb(each3!(|i| l
+            .mul_add(F::splat(s.lit[i]), F::splat(s.unlit[i]))
+            * c[i]))
+    }
+}
+
+/// `Vec3::from_relative` on lanes: `r0 + r1·w1 + r2·w2`, fused, inner first.
+#[inline(always)]
+fn relative_lanes<F: F32s>(r: [Vec3; 3], w: &[F; 3]) -> [F; 3] {
+    each3!(|i| F::splat(r[2][i]).mul_add(w[2], F::splat(r[1][i]).mul_add(w[1], F::splat(r[0][i]))))
+}
+
 #[cfg(test)]
 mod tests {
     use glam::{Mat4, Vec3};
     use proptest::prelude::*;
     use wide::f32x8;
 
-    use super::Lambert;
+    use super::{ColoredLambert, Lambert};
     use crate::mesh::Mesh;
     use crate::raster::interp::{Direction, Varying};
     use crate::render::perspective_weights;
@@ -195,6 +253,40 @@ mod tests {
             for k in (0..8).filter(|k| mask >> k & 1 == 1) {
                 let v = Direction::from_relative(&rel, [w[0][k], w[1][k], w[2][k]]);
                 let one = shader.fragment(&v);
+                for (c, lane) in one.to_array().iter().zip(rgb) {
+                    prop_assert_eq!(c.to_bits(), lane[k].to_bits(), "lane {}", k);
+                }
+            }
+        }
+
+        /// The coloured Lambert's 8-lane fragments equal its per-pixel ones bit for
+        /// bit: the normal and the colour interpolated as `Vec3` varyings are, then lit.
+        #[test]
+        fn colored_lambert_lanes_equal_single_fragments(
+            normals in prop::array::uniform3(vec3()),
+            colors in prop::array::uniform3(prop::array::uniform3(0.0f32..1.0)),
+            w in prop::array::uniform3(prop::array::uniform8(0.0f32..1.0)),
+            base in vec3(),
+            ambient in 0.0f32..0.5,
+            mask in 1..=255u8,
+        ) {
+            let mesh = Mesh::teapot();
+            let shader = ColoredLambert(
+                Lambert::new(&mesh, Mat4::IDENTITY, Mat4::IDENTITY)
+                    .with_material(base.abs(), ambient),
+            );
+            let v = |i: usize| (normals[i], Vec3::from(colors[i]));
+            let rel = <(Vec3, Vec3)>::relative(&v(0), &v(1), &v(2));
+            let lanes = w.map(f32x8::from);
+            let ShadeLanes::Rgb(rgb) = shader.fragment_lanes(&rel, &lanes, mask.into()) else {
+                panic!("a coloured shader shades three channels");
+            };
+            let rgb = rgb.map(F32s::to_array);
+            for k in (0..8).filter(|k| mask >> k & 1 == 1) {
+                let one = shader.fragment(&<(Vec3, Vec3)>::from_relative(
+                    &rel,
+                    [w[0][k], w[1][k], w[2][k]],
+                ));
                 for (c, lane) in one.to_array().iter().zip(rgb) {
                     prop_assert_eq!(c.to_bits(), lane[k].to_bits(), "lane {}", k);
                 }

@@ -205,16 +205,27 @@ fn turned(angle: f32) -> SceneView {
     }
 }
 
+/// The probe equals the framebuffer at every pixel, for the lane-code Lambert and
+/// for its form with vertex colours (the sphere's).
 #[test]
 fn probe_equals_the_framebuffer_for_every_pixel() {
-    let mut scene = bunny();
-    assert_eq!(scene.objects[0].mesh.triangle_count(), 3674);
+    let bunny = bunny();
+    assert_eq!(bunny.objects[0].mesh.triangle_count(), 3674);
+    let sphere = Scene::standard("sphere:3000").expect("the sphere");
     let target = Target::new(120, 90);
-    for (angle, cull) in [(0.7f32, false), (2.1, true)] {
+    for ((mut scene, pipeline), (angle, cull)) in [
+        (bunny.clone(), "lambert"),
+        (bunny, "lambert"),
+        (sphere.clone(), "lambert-colors"),
+        (sphere, "lambert-colors"),
+    ]
+    .into_iter()
+    .zip([(0.7f32, false), (2.1, true)].into_iter().cycle())
+    {
         scene.set_cull(cull);
         let mut frame = SceneFrame::new(&scene);
         frame.draw(&scene, target, &turned(angle));
-        assert_eq!(frame.pipelines(), ["lambert"]);
+        assert_eq!(frame.pipelines(), [pipeline]);
         let color = &frame.color;
         let mut winners = 0;
         for y in 0..target.height {
@@ -255,7 +266,7 @@ fn probe_equals_the_framebuffer_for_every_pixel() {
                 }
             }
         }
-        assert!(winners > 2000, "the bunny covers the frame ({winners})");
+        assert!(winners > 2000, "the model covers the frame ({winners})");
     }
 }
 

@@ -295,16 +295,21 @@ fn render_plan_and_bad_scene_from_the_command_line() {
 }
 
 /// Pass: an object whose plan is exactly the standard one (a model's default scene,
-/// and the coloured lit teapot) is drawn by the lane-code Lambert pipeline, and a
-/// model's scene has the bits the model's standard frame had seen the same way (as
-/// recorded in `model_frames`); any other plan takes the packed shader.
+/// and the coloured lit teapot) is drawn by the lane-code Lambert pipeline, one with
+/// vertex colours besides (the sphere's) by its coloured form, and a model's scene has
+/// the bits the model's standard frame had seen the same way (as recorded in
+/// `model_frames`); any other plan takes the packed shader.
 #[test]
 fn the_standard_plan_takes_the_lambert_pipeline() {
     let target = Target::new(160, 120);
-    for spec in ["teapot", "bunny"] {
+    for (spec, pipeline) in [
+        ("teapot", "lambert"),
+        ("bunny", "lambert"),
+        ("sphere:20000", "lambert-colors"),
+    ] {
         let scene = Scene::for_model(spec).unwrap();
         let mut frame = SceneFrame::new(&scene);
-        assert_eq!(frame.pipelines(), ["lambert"], "{spec}");
+        assert_eq!(frame.pipelines(), [pipeline], "{spec}");
         frame.draw(&scene, target, &SceneView::default());
         let color = &frame.color.0;
         assert!(color.iter().filter(|p| p[3] == 255).count() > 1000);
@@ -330,6 +335,24 @@ fn the_standard_plan_takes_the_lambert_pipeline() {
     )
     .unwrap();
     assert_eq!(SceneFrame::new(&fog).pipelines(), ["packed"]);
+    // The sphere without its colours, with them, and lit by lights of the file's own.
+    for (material, lights, pipeline) in [
+        ("", "", "lambert"),
+        ("vertex_colors = true\n", "", "lambert-colors"),
+        ("from_model = true\n", "", "lambert-colors"),
+        (
+            "from_model = true\n",
+            "[[light]]\nkind = \"ambient\"\n",
+            "packed",
+        ),
+    ] {
+        let text = format!(
+            "{lights}[[object]]\nmodel = \"sphere:500\"\n[object.material]\n\
+             lighting = \"lambert\"\n{material}[object.effects]\ndepth_test = true\n"
+        );
+        let scene = Scene::from_text(&text, Path::new("sphere.toml")).unwrap();
+        assert_eq!(SceneFrame::new(&scene).pipelines(), [pipeline], "{text}");
+    }
 }
 
 /// Pass: `fill = false` draws an object's edges and nothing of its triangles: the plan

@@ -369,7 +369,8 @@ impl<S: Shading> ObjectPipeline for Pipeline<S> {
 }
 
 /// The pipeline for an object of a scene lit by `lights`: the lane-code Lambert when
-/// its plan is exactly the standard one ([`is_standard_lambert`]), else the packed
+/// its plan is exactly the standard one ([`is_standard_lambert`]) or that with vertex
+/// colours ([`is_colored_lambert`]), else the packed
 /// shader at the narrowest of [`PACKED_WIDTHS`] that holds its varyings.
 #[must_use]
 pub fn pipeline_for(
@@ -387,6 +388,9 @@ pub fn pipeline_for(
     let varyings = plan.varyings;
     if is_standard_lambert(obj, plan, lights) {
         return new::<StandardLambert>(varyings);
+    }
+    if is_colored_lambert(obj, plan, lights) {
+        return new::<StandardColoredLambert>(varyings);
     }
     match Layout::new(varyings).len {
         0 => new::<Packed<0>>(varyings),

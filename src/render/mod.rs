@@ -10,7 +10,7 @@
 //! | `fragments` | the coverage sink that tests depth and shades |
 //! | [`probe`](mod@probe) | one pixel's raster state, recomputed on demand |
 //! | `isa` | the compiled copies of the draw loop and the one choice among them |
-//! | `tiles` | drawing on several threads: set-up binned by bands of rows, each band walked in draw order |
+//! | `tiles` | drawing on several threads: set-up binned by bands of rows, each band walked in draw order (`tiles/queue`: which thread walks which band) |
 //! | this file | [`Renderer`]: frame state and the triangle loop |
 //!
 //! Screen mapping ([`ndc_to_screen`]): NDC x ∈ [−1, 1] maps to pixels [0, width] left
@@ -70,11 +70,11 @@ pub use isa::{DrawCopy, DrawVariant, Fast, Generic, Isa, Standard, Variant};
 pub use options::{Cull, DrawOptions, DrawStats};
 pub use prepare::{
     EmitPiece, PrepareOutcome, Prepared, Projected, VertexCache, ndc_to_screen, prepare,
-    prepare_projected, project_vertices, transform,
+    prepare_projected, project_vertices, transform, transform_projected,
 };
 pub use shader::{ShadeLanes, Shader};
 pub use target::{ColorTarget, Rgba8, Rgba8Rows};
-pub use tiles::BAND_ROWS;
+pub use tiles::{BAND_ROWS, band_rows};
 
 /// Owns the depth buffer and frame counters; draws meshes into a colour target.
 #[derive(Debug)]
@@ -90,8 +90,6 @@ pub struct Renderer {
     pool: Option<Arc<rayon::ThreadPool>>,
     /// The threaded draws' set-up records and bins, reused between draws.
     scratch: tiles::Scratch,
-    /// Rows per band of a threaded draw.
-    band_rows: u32,
     /// The background of a colour clear left to the frame's first threaded draw
     /// ([`Renderer::begin_frame_deferred`]).
     pending_clear: Option<Vec3>,
@@ -125,9 +123,11 @@ impl Renderer {
             projected: Vec::new(),
             pool: None,
             scratch: tiles::Scratch::default(),
-            band_rows: BAND_ROWS,
             pending_clear: None,
-            min_threaded_work: MIN_THREADED_WORK,
+            min_threaded_work: std::env::var("TERMRAST_MINWORK")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(MIN_THREADED_WORK),
             threaded: false,
             frame_threads: true,
         }
@@ -174,30 +174,29 @@ impl Renderer {
         self.pool.as_ref().filter(|_| self.frame_threads)
     }
 
-    /// [`transform`] on the renderer's threads: the same vertices, in chunks of
-    /// the vertex array.
+    /// [`transform_projected`] for the renderer's target, on its threads (the same
+    /// vertices, in chunks of the vertex array): the draws that follow use the
+    /// projections instead of making their own.
     pub fn transform<S: Shader>(
         &self,
         shader: &S,
         vertex_count: usize,
         cache: &mut VertexCache<S::Varying>,
     ) {
+        let target = self.target;
         let Some(pool) = self.pool() else {
-            transform(shader, vertex_count, cache);
+            transform_projected(shader, vertex_count, cache, target);
             return;
         };
         pool.install(|| {
             use rayon::prelude::*;
-            cache.verts.clear();
-            cache.verts.par_extend(
-                (0..vertex_count as u32)
-                    .into_par_iter()
-                    .with_min_len(tiles::VERTEX_JOB)
-                    .map(|i| {
-                        let (pos, var) = shader.vertex(i);
-                        crate::raster::clip::ClipVertex { pos, var }
-                    }),
-            );
+            let guard = crate::raster::clip::guard_band_ndc(target.width, target.height);
+            (0..vertex_count as u32)
+                .into_par_iter()
+                .with_min_len(tiles::VERTEX_JOB)
+                .map(|i| prepare::project_vertex(shader, i, target, guard))
+                .unzip_into_vecs(&mut cache.verts, &mut cache.projected);
+            cache.projected_for = Some(target);
         });
     }
 
@@ -256,7 +255,8 @@ impl Renderer {
             return;
         };
         use rayon::prelude::*;
-        let band = self.band_rows as usize * self.target.width as usize;
+        let rows = tiles::band_rows(self.target.height, pool.current_num_threads());
+        let band = rows as usize * self.target.width as usize;
         pool.install(|| {
             color.bands(band).for_each(|mut b| {
                 let len = b.len();
@@ -325,13 +325,19 @@ impl Renderer {
         debug_assert!(V::admits(opts), "{opts:?} run on a copy not built for it");
         let target = self.target;
         let mut projected = std::mem::take(&mut self.projected);
-        project_vertices(cache, target, &mut projected);
+        let pv = match cache.projections(target) {
+            Some(pv) => pv,
+            None => {
+                project_vertices(cache, target, &mut projected);
+                &projected[..]
+            }
+        };
         let mut walker =
             PieceWalker::<S, C, L, V, _>::new(shader, &mut self.depth, color, opts, target);
         let n = (indices.len() / 3) as u32;
         for t in 0..n {
             walker.stats.triangles += 1;
-            let pv = Some(&projected[..]);
+            let pv = Some(pv);
             match prepare_projected(cache, pv, indices, t, target, opts.cull, &mut walker) {
                 PrepareOutcome::Rejected => walker.stats.rejected += 1,
                 PrepareOutcome::Culled => walker.stats.culled += 1,

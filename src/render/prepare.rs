@@ -54,16 +54,33 @@ pub struct Prepared<V> {
     pub edge_rem: [f32; 3],
 }
 
-/// Reusable per-draw storage: transformed vertices. Kept by the caller so a steady
-/// viewer allocates nothing per frame.
+/// Reusable per-draw storage: transformed vertices, and their projections when the
+/// vertex stage made them too. Kept by the caller so a steady viewer allocates nothing
+/// per frame.
 #[derive(Debug)]
 pub struct VertexCache<V> {
     pub(crate) verts: Vec<ClipVertex<V>>,
+    /// The vertices projected for `projected_for` ([`transform_projected`]).
+    pub(crate) projected: Vec<Projected>,
+    /// The target `projected` is for; `None` when the vertices were transformed alone.
+    pub(crate) projected_for: Option<Target>,
 }
 
 impl<V> Default for VertexCache<V> {
     fn default() -> Self {
-        Self { verts: Vec::new() }
+        Self {
+            verts: Vec::new(),
+            projected: Vec::new(),
+            projected_for: None,
+        }
+    }
+}
+
+impl<V> VertexCache<V> {
+    /// The vertices' projections for `target`, if the vertex stage made them.
+    #[must_use]
+    pub fn projections(&self, target: Target) -> Option<&[Projected]> {
+        (self.projected_for == Some(target)).then_some(&self.projected[..])
     }
 }
 
@@ -76,11 +93,47 @@ pub enum PrepareOutcome {
 
 /// Transforms every vertex once into the cache.
 pub fn transform<S: Shader>(shader: &S, vertex_count: usize, cache: &mut VertexCache<S::Varying>) {
+    cache.projected_for = None;
     cache.verts.clear();
     cache.verts.extend((0..vertex_count as u32).map(|i| {
         let (pos, var) = shader.vertex(i);
         ClipVertex { pos, var }
     }));
+}
+
+/// [`transform`] and [`project_vertices`] for `target` in one pass: each vertex is
+/// projected while it is in registers, instead of being read back from a cache that
+/// a large mesh has long pushed out of the processor's (a million-triangle mesh's
+/// vertices are some 25 MB).
+pub fn transform_projected<S: Shader>(
+    shader: &S,
+    vertex_count: usize,
+    cache: &mut VertexCache<S::Varying>,
+    target: Target,
+) {
+    let guard = guard_band_ndc(target.width, target.height);
+    cache.verts.clear();
+    cache.projected.clear();
+    cache.verts.reserve(vertex_count);
+    cache.projected.reserve(vertex_count);
+    for i in 0..vertex_count as u32 {
+        let (v, p) = project_vertex(shader, i, target, guard);
+        cache.verts.push(v);
+        cache.projected.push(p);
+    }
+    cache.projected_for = Some(target);
+}
+
+/// Vertex `i` through the vertex stage, and its projection.
+#[inline(always)]
+pub(crate) fn project_vertex<S: Shader>(
+    shader: &S,
+    i: u32,
+    target: Target,
+    guard: [f32; 2],
+) -> (ClipVertex<S::Varying>, Projected) {
+    let (pos, var) = shader.vertex(i);
+    (ClipVertex { pos, var }, Projected::of(pos, target, guard))
 }
 
 /// Receives the pieces [`prepare`] makes of a triangle. A trait rather than a closure
@@ -331,4 +384,45 @@ fn setup_piece<V: Varying>(
         edge_rem,
     });
     Piece::Drawn
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Mat4, Vec3};
+
+    use super::*;
+    use crate::camera::Camera;
+    use crate::mesh::Mesh;
+    use crate::render::shaders::Lambert;
+
+    /// The vertex stage with its projections made in the same pass gives the vertices
+    /// of [`transform`] and the projections of [`project_vertices`], bit for bit, and
+    /// a later [`transform`] forgets them.
+    #[test]
+    fn projecting_in_the_vertex_pass_changes_nothing() {
+        let mesh = Mesh::teapot();
+        let target = Target::new(123, 77);
+        // Far, and so near that vertices leave the frustum and the guard band.
+        for eye in [Vec3::new(0.3, 0.5, 3.0), Vec3::new(0.0, 0.2, 0.4)] {
+            let cam = Camera {
+                eye,
+                ..Camera::default()
+            };
+            let view_proj = cam.projection(target.width, target.height, 1.0) * cam.view();
+            let shader = Lambert::new(&mesh, Mat4::IDENTITY, view_proj);
+            let n = mesh.positions.len();
+            let (mut apart, mut fused) = (VertexCache::default(), VertexCache::default());
+            transform(&shader, n, &mut apart);
+            let mut projected = Vec::new();
+            project_vertices(&apart, target, &mut projected);
+            transform_projected(&shader, n, &mut fused, target);
+            assert_eq!(format!("{:?}", apart.verts), format!("{:?}", fused.verts));
+            let pv = fused.projections(target).expect("made with the vertices");
+            assert_eq!(format!("{projected:?}"), format!("{pv:?}"));
+            assert!(apart.projections(target).is_none());
+            assert!(fused.projections(Target::new(124, 77)).is_none());
+            transform(&shader, n, &mut fused);
+            assert!(fused.projections(target).is_none());
+        }
+    }
 }

@@ -2,9 +2,10 @@
 //!
 //! A draw runs in three parallel steps on the renderer's thread pool:
 //!
-//! 1. **Vertices**: every vertex is projected once ([`Projected::of`]), in parallel
-//!    chunks of the vertex array (the vertex stage itself runs the same way in
-//!    [`super::Renderer::transform`]).
+//! 1. **Vertices**: every vertex goes through the vertex stage and is projected once
+//!    ([`Projected::of`]), in parallel chunks of the vertex array, in one pass
+//!    ([`super::Renderer::transform`]; a draw whose vertices were transformed alone
+//!    projects them here, the same way).
 //! 2. **Set-up and binning**: the triangles are cut into chunks of consecutive
 //!    triangles; each chunk's thread clips and sets up its triangles once
 //!    ([`prepare_projected`], as on one thread) into the chunk's records, in draw order,
@@ -15,8 +16,10 @@
 //!    walked in each with its box cut to the band's rows ([`Setup::rows`], the same
 //!    edge values at every pixel), so every pixel gets the same fragments, in the same
 //!    order, through the same copy of the draw loop ([`super::DrawCopy::choose`]).
+//!    Which thread walks which band, and when, is up to `queue`: costliest first
+//!    within each thread's run of bands, so that the threads finish together.
 //!
-//! The tiles are bands of whole rows ([`BAND_ROWS`] high) rather than squares: a band
+//! The tiles are bands of whole rows ([`band_rows`] high) rather than squares: a band
 //! is one contiguous slice of the colour target and one of the depth buffer (and its
 //! clear bits), so the threads own disjoint borrows and no lock or atomic is needed;
 //! and the `wide` walk puts 8-pixel groups anywhere on a row (a group may start left of
@@ -45,9 +48,12 @@ use crate::raster::clip::guard_band_ndc;
 use crate::raster::depth::DepthRows;
 use crate::raster::{Setup, Target};
 use crate::simd::I32s;
+use queue::plan_bands;
 
-/// Rows per band: a multiple of the block traversal's 8 and of the depth clear tile.
-/// Chosen by measurement (see `docs/performance.md`).
+mod queue;
+
+/// The tallest band: a multiple of the block traversal's 8 and of the depth clear
+/// tile. Chosen by measurement (see `docs/performance.md`).
 pub const BAND_ROWS: u32 = 48;
 
 /// Triangles per chunk of a batch (see [`draw`]): a batch's records stay a few
@@ -62,6 +68,10 @@ const CHUNKS_PER_THREAD: usize = 4;
 /// than they save).
 pub(super) const VERTEX_JOB: usize = 2048;
 
+/// What a piece costs the walk of a band besides its pixels, in pixels (the walk's
+/// per-triangle set-up: its first row's edge values and groups).
+const RECORD_COST: u64 = 24;
+
 /// A run of consecutive triangles set up by one thread.
 #[derive(Debug)]
 pub(super) struct Chunk<V> {
@@ -69,6 +79,9 @@ pub(super) struct Chunk<V> {
     records: Vec<Prepared<V>>,
     /// Per band, the indices in `records` of the pieces whose box touches it, ascending.
     bins: Vec<Vec<u32>>,
+    /// Per band, the work its bin holds: box pixels in the band plus [`RECORD_COST`]
+    /// per piece (the order bands are walked in, [`band_order`]).
+    cost: Vec<u64>,
     /// The triangle counters of the chunk (the fragment counters come from the walk).
     stats: DrawStats,
 }
@@ -78,6 +91,7 @@ impl<V> Default for Chunk<V> {
         Self {
             records: Vec::new(),
             bins: Vec::new(),
+            cost: Vec::new(),
             stats: DrawStats::default(),
         }
     }
@@ -90,10 +104,15 @@ struct Bins<V> {
 }
 
 /// What the threaded path keeps between draws: the chunks of each varying type drawn
-/// so far (a scene's objects may differ), so that a steady frame reuses them.
+/// so far (a scene's objects may differ), and the bands' walking order, so that a
+/// steady frame reuses them.
 #[derive(Default)]
 pub(super) struct Scratch {
     bins: Vec<Box<dyn Any + Send>>,
+    /// Band indices, costliest first.
+    order: Vec<u32>,
+    /// Per band, the work of the batch being walked.
+    cost: Vec<u64>,
 }
 
 impl std::fmt::Debug for Scratch {
@@ -105,8 +124,13 @@ impl std::fmt::Debug for Scratch {
 }
 
 impl Scratch {
-    /// The chunks for varying type `V`: `chunks` of them, each with `bands` empty bins.
-    fn chunks<V: Send + 'static>(&mut self, chunks: usize, bands: usize) -> &mut [Chunk<V>] {
+    /// The chunks for varying type `V`: `chunks` of them, each with `bands` empty bins,
+    /// and the band order and costs.
+    fn chunks<V: Send + 'static>(
+        &mut self,
+        chunks: usize,
+        bands: usize,
+    ) -> (&mut [Chunk<V>], &mut Vec<u32>, &mut Vec<u64>) {
         let i = match self.bins.iter().position(|b| (**b).is::<Bins<V>>()) {
             Some(i) => i,
             None => {
@@ -120,8 +144,11 @@ impl Scratch {
         bins.chunks.resize_with(chunks, Chunk::default);
         for c in &mut bins.chunks {
             c.bins.resize_with(bands, Vec::new);
+            c.cost.resize(bands, 0);
         }
-        &mut bins.chunks[..chunks]
+        self.order.resize(bands, 0);
+        self.cost.resize(bands, 0);
+        (&mut bins.chunks[..chunks], &mut self.order, &mut self.cost)
     }
 }
 
@@ -179,24 +206,31 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
         unreachable!("a threaded draw without a pool");
     };
     let target = r.target;
-    let band_rows = r.band_rows;
+    let threads = pool.current_num_threads();
+    let band_rows = band_rows(target.height, threads);
     let bands = target.height.div_ceil(band_rows) as usize;
     let triangles = indices.len() / 3;
-    let n = (pool.current_num_threads() * CHUNKS_PER_THREAD).clamp(1, triangles.max(1));
-    let chunks = r.scratch.chunks::<S::Varying>(n, bands);
+    let n = (threads * CHUNKS_PER_THREAD).clamp(1, triangles.max(1));
+    let (chunks, order, cost) = r.scratch.chunks::<S::Varying>(n, bands);
     let projected = &mut r.projected;
     let depth = &mut r.depth;
     let mut clear = r.pending_clear.take();
     let stats = pool.install(|| {
-        let guard = guard_band_ndc(target.width, target.height);
-        projected.clear();
-        projected.par_extend(
-            cache
-                .verts
-                .par_iter()
-                .with_min_len(VERTEX_JOB)
-                .map(|v| Projected::of(v.pos, target, guard)),
-        );
+        let projected = match cache.projections(target) {
+            Some(pv) => pv,
+            None => {
+                let guard = guard_band_ndc(target.width, target.height);
+                projected.clear();
+                projected.par_extend(
+                    cache
+                        .verts
+                        .par_iter()
+                        .with_min_len(VERTEX_JOB)
+                        .map(|v| Projected::of(v.pos, target, guard)),
+                );
+                &projected[..]
+            }
+        };
         let job = Job {
             shader,
             cache,
@@ -209,8 +243,8 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
         let mut stats = DrawStats::default();
         // Batches of triangles, each set up and then walked, so the records of a large
         // mesh are a few megabytes reused, not one record per triangle of the mesh.
-        let batch = n * CHUNK_TRIANGLES;
         // At least one batch: it also clears the colour if that is pending.
+        let batch = n * CHUNK_TRIANGLES;
         for first in (0..triangles.max(1)).step_by(batch) {
             let count = batch.min(triangles.saturating_sub(first));
             let clear = clear.take();
@@ -230,18 +264,25 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
                 bands,
                 "the colour target is not the frame's size"
             );
-            let walked = colors
-                .zip(depth.bands(band_rows))
-                .enumerate()
-                .with_max_len(1)
-                .map(|(b, (mut color, mut depth))| {
-                    // SAFETY: the caller's guarantee.
-                    unsafe { T::walk(&job, chunks, b, &mut color, &mut depth, clear) }
-                })
-                .reduce(DrawStats::default, |mut a, b| {
-                    a += b;
-                    a
-                });
+            let bands = colors.zip(depth.bands(band_rows));
+            let walk = |b: usize, (mut color, mut depth): (C::Rows<'_>, DepthRows<'_>)| {
+                // SAFETY: the caller's guarantee.
+                unsafe { T::walk(&job, chunks, b, &mut color, &mut depth, clear) }
+            };
+            for (b, c) in cost.iter_mut().enumerate() {
+                *c = chunks.iter().map(|ch| ch.cost[b]).sum();
+            }
+            let walked = match plan_bands(order, cost, threads) {
+                Some(queues) => queue::walk_in_order(bands, queues, order, &walk),
+                None => bands
+                    .enumerate()
+                    .with_max_len(1)
+                    .map(|(b, rows)| walk(b, rows))
+                    .reduce(DrawStats::default, |mut a, b| {
+                        a += b;
+                        a
+                    }),
+            };
             stats += walked;
             for c in chunks {
                 stats += c.stats;
@@ -250,6 +291,17 @@ pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
         stats
     });
     r.stats += stats;
+}
+
+/// Rows per band for a target `height` drawn on `threads` threads: about six bands
+/// per thread, so that the costliest-first hand-out can even the threads out, but at
+/// most [`BAND_ROWS`] (taller bands leave too few to share; shorter ones make more
+/// triangles cross a border and be walked twice). A multiple of 8 (the block walk's
+/// blocks and two depth clear tiles).
+#[must_use]
+pub fn band_rows(height: u32, threads: usize) -> u32 {
+    let per = height / (6 * threads.max(1) as u32);
+    (per / 8 * 8).clamp(8, BAND_ROWS)
 }
 
 /// Files each piece into its chunk and the bins of the bands its box touches.
@@ -271,8 +323,12 @@ impl<V: Copy> EmitPiece<V> for Binner<'_, V> {
         let c = &mut *self.chunk;
         let i = c.records.len() as u32;
         c.records.push(*p);
-        for band in b.y0 / self.band_rows..b.y1 / self.band_rows + 1 {
+        let rows = self.band_rows;
+        for band in b.y0 / rows..b.y1 / rows + 1 {
             c.bins[band as usize].push(i);
+            let y0 = b.y0.max(band * rows);
+            let y1 = b.y1.min(band * rows + rows - 1);
+            c.cost[band as usize] += u64::from((y1 - y0 + 1) * b.width()) + RECORD_COST;
         }
     }
 }
@@ -304,6 +360,7 @@ pub(super) fn setup_chunk<S: Shader>(
     for b in &mut chunk.bins {
         b.clear();
     }
+    chunk.cost.fill(0);
     let mut stats = DrawStats::default();
     let mut binner = Binner {
         chunk,
@@ -367,4 +424,30 @@ pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
         }
     }
     walker.stats
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{BAND_ROWS, band_rows};
+
+    /// Bands are whole blocks of 8 rows, at most `BAND_ROWS`, and about six per
+    /// thread wherever the target is tall enough for that.
+    #[test]
+    fn bands_are_blocks_of_rows_about_six_per_thread() {
+        for threads in 1..=8 {
+            for height in 1..2000 {
+                let rows = band_rows(height, threads);
+                assert!(rows.is_multiple_of(8) && (8..=BAND_ROWS).contains(&rows));
+                let bands = height.div_ceil(rows) as usize;
+                if rows < BAND_ROWS && rows > 8 {
+                    assert!(
+                        (6 * threads..12 * threads).contains(&bands),
+                        "{height} {threads}"
+                    );
+                }
+            }
+        }
+        assert_eq!(band_rows(240, 2), 16);
+        assert_eq!(band_rows(1080, 2), BAND_ROWS);
+    }
 }

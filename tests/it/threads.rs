@@ -11,7 +11,7 @@ use termrast::raster::interp::Interpolation;
 use termrast::raster::{Target, Traversal};
 use termrast::render::probe::DepthOutcome;
 use termrast::render::target::to_u8;
-use termrast::render::{BAND_ROWS, DrawOptions, DrawStats, Isa, Renderer, VertexCache};
+use termrast::render::{BAND_ROWS, DrawOptions, DrawStats, Isa, Renderer, VertexCache, band_rows};
 use termrast::scene::Scene;
 use termrast::scene::render::{SceneFrame, SceneView};
 
@@ -100,13 +100,16 @@ fn threaded_frames_equal_one_thread_for_every_model_option_and_isa() {
 }
 
 /// Targets smaller than a band, a group or a pixel row of a band, one band exactly and
-/// just over one, the model reaching past every side.
+/// just over one (for the shortest bands and the tallest), the model reaching past
+/// every side.
 #[test]
 fn targets_smaller_than_a_band_draw_the_same_frame() {
     let mut scene = model("bunny");
     scene.camera.eye = Vec3::new(0.0, 0.0, 1.3);
     let view = turned(0.4);
     let b = BAND_ROWS;
+    let tall = 12 * b;
+    assert_eq!(band_rows(tall, 2), b);
     for (w, h) in [
         (1, 1),
         (3, 5),
@@ -118,6 +121,12 @@ fn targets_smaller_than_a_band_draw_the_same_frame() {
         (40, b),
         (40, b + 1),
         (33, 2 * b + 3),
+        (12, 7),
+        (12, 8),
+        (12, 17),
+        (9, tall - 1),
+        (9, tall),
+        (9, tall + 1),
     ] {
         let target = Target::new(w, h);
         for options in every_option() {
@@ -206,12 +215,18 @@ fn options(traversal: Traversal, interpolation: Interpolation, func: DepthFunc) 
 /// at every one of the 256 subpixel offsets (and vertices exactly on it), overlapping
 /// at equal and unequal depths so the order of the writes shows: the same exact
 /// colours, writes per pixel, depth and counters on 1 and 2 threads, for every
-/// traversal.
+/// traversal; on a short target (the shortest bands) and a tall one (the tallest).
 #[test]
 fn triangles_crossing_a_band_border_at_every_subpixel_draw_the_same() {
-    let target = Target::new(48, 2 * BAND_ROWS + 5);
-    let border = BAND_ROWS as f32;
-    for sub in 0..256u32 {
+    let short = Target::new(48, 45);
+    let tall = Target::new(48, 12 * BAND_ROWS + 5);
+    assert_eq!(band_rows(short.height, 2), 8);
+    assert_eq!(band_rows(tall.height, 2), BAND_ROWS);
+    for (target, sub) in (0..256u32)
+        .map(|s| (short, s))
+        .chain((0..256).map(|s| (tall, s)))
+    {
+        let border = band_rows(target.height, 2) as f32;
         let off = sub as f32 / 256.0;
         let y = border - 0.5 + off;
         let p = |x: f32, y: f32, z: f32| at_pixel(target, x, y, z);
@@ -243,7 +258,10 @@ fn triangles_crossing_a_band_border_at_every_subpixel_draw_the_same() {
                 let one = draw_direct(&shader, &indices, target, &o, 1);
                 assert!(one.3.fragments > 100, "{sub}: the fan covers pixels");
                 let two = draw_direct(&shader, &indices, target, &o, 2);
-                assert!(one == two, "subpixel {sub}, {traversal:?}, {func:?}");
+                assert!(
+                    one == two,
+                    "{target:?} subpixel {sub}, {traversal:?}, {func:?}"
+                );
             }
         }
     }

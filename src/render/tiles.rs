@@ -356,9 +356,15 @@ pub(super) fn setup_chunk<S: Shader>(
     range: Range<u32>,
     chunk: &mut Chunk<S::Varying>,
 ) {
+    // Room for every triangle of the range in the records and in every bin (a piece
+    // per triangle unless clipping splits it): kept from draw to draw, so a model
+    // turning into new shapes does not grow them frame after frame.
+    let room = range.len();
     chunk.records.clear();
+    chunk.records.reserve(room);
     for b in &mut chunk.bins {
         b.clear();
+        b.reserve(room);
     }
     chunk.cost.fill(0);
     let mut stats = DrawStats::default();

@@ -103,6 +103,12 @@ pub struct Renderer {
     frame_threads: bool,
 }
 
+/// The fewest vertices the one-thread vertex stage projects in its own pass
+/// ([`transform_projected`]): a smaller mesh's vertices are still in the cache when
+/// the draw projects them, in its own copy of the loop (AVX2 and FMA), which is
+/// faster than the vertex stage's.
+pub const FUSED_PROJECTION_VERTICES: usize = 1 << 16;
+
 /// Pixels a triangle's share of a draw is worth, for [`Renderer::min_threaded_work`]:
 /// set-up and binning, which many small triangles make the larger part.
 pub const TRIANGLE_WORK: u64 = 32;
@@ -176,7 +182,8 @@ impl Renderer {
 
     /// [`transform_projected`] for the renderer's target, on its threads (the same
     /// vertices, in chunks of the vertex array): the draws that follow use the
-    /// projections instead of making their own.
+    /// projections instead of making their own. On one thread, a mesh of fewer than
+    /// [`FUSED_PROJECTION_VERTICES`] is only transformed.
     pub fn transform<S: Shader>(
         &self,
         shader: &S,
@@ -185,7 +192,11 @@ impl Renderer {
     ) {
         let target = self.target;
         let Some(pool) = self.pool() else {
-            transform_projected(shader, vertex_count, cache, target);
+            if vertex_count >= FUSED_PROJECTION_VERTICES {
+                transform_projected(shader, vertex_count, cache, target);
+            } else {
+                transform(shader, vertex_count, cache);
+            }
             return;
         };
         pool.install(|| {

@@ -105,7 +105,7 @@ pub struct Renderer {
 
 /// The fewest vertices the one-thread vertex stage projects in its own pass
 /// ([`transform_projected`]): a smaller mesh's vertices are still in the cache when
-/// the draw projects them, in its own copy of the loop (AVX2 and FMA), which is
+/// the draw projects them, in its own copy of the loop (AVX2 or AVX-512), which is
 /// faster than the vertex stage's.
 pub const FUSED_PROJECTION_VERTICES: usize = 1 << 16;
 
@@ -130,10 +130,7 @@ impl Renderer {
             pool: None,
             scratch: tiles::Scratch::default(),
             pending_clear: None,
-            min_threaded_work: std::env::var("TERMRAST_MINWORK")
-                .ok()
-                .and_then(|v| v.parse().ok())
-                .unwrap_or(MIN_THREADED_WORK),
+            min_threaded_work: MIN_THREADED_WORK,
             threaded: false,
             frame_threads: true,
         }

@@ -78,20 +78,38 @@ const RECORD_COST: u64 = 24;
 pub(super) struct Chunk<V> {
     /// The pieces that reached the rasterizer, in draw order.
     records: Vec<Prepared<V>>,
-    /// Per band, the indices in `records` of the pieces whose box touches it, ascending.
-    bins: Vec<Vec<u32>>,
+    /// The bins, one after another: band `b`'s is `entries[starts[b]..starts[b + 1]]`,
+    /// the indices in `records` of the pieces whose box touches it, ascending. One
+    /// array per chunk keeps the memory in proportion to the pieces, whatever the
+    /// number of bands.
+    entries: Vec<u32>,
+    /// Where each band's bin starts in `entries`, and where the last ends (while
+    /// binning, `starts[b + 1]` counts band `b`'s pieces).
+    starts: Vec<u32>,
+    /// Per record, the first and last band its box touches: what filling the bins
+    /// reads, instead of each record's cache line again.
+    spans: Vec<[u16; 2]>,
     /// Per band, the work its bin holds: box pixels in the band plus [`RECORD_COST`]
-    /// per piece (the order bands are walked in, [`band_order`]).
+    /// per piece (the order bands are walked in: `queue::plan_bands`).
     cost: Vec<u64>,
     /// The triangle counters of the chunk (the fragment counters come from the walk).
     stats: DrawStats,
+}
+
+impl<V> Chunk<V> {
+    /// The indices in `records` of band `band`'s pieces, in draw order.
+    fn bin(&self, band: usize) -> &[u32] {
+        &self.entries[self.starts[band] as usize..self.starts[band + 1] as usize]
+    }
 }
 
 impl<V> Default for Chunk<V> {
     fn default() -> Self {
         Self {
             records: Vec::new(),
-            bins: Vec::new(),
+            entries: Vec::new(),
+            starts: Vec::new(),
+            spans: Vec::new(),
             cost: Vec::new(),
             stats: DrawStats::default(),
         }
@@ -144,7 +162,7 @@ impl Scratch {
             .expect("the entry's type was just checked");
         bins.chunks.resize_with(chunks, Chunk::default);
         for c in &mut bins.chunks {
-            c.bins.resize_with(bands, Vec::new);
+            c.starts.resize(bands + 1, 0);
             c.cost.resize(bands, 0);
         }
         self.order.resize(bands, 0);
@@ -305,7 +323,8 @@ pub fn band_rows(height: u32, threads: usize) -> u32 {
     (per / 8 * 8).clamp(8, BAND_ROWS)
 }
 
-/// Files each piece into its chunk and the bins of the bands its box touches.
+/// Files each piece into its chunk and counts it in the bins of the bands its box
+/// touches ([`fill_bins`] then places it).
 struct Binner<'a, V> {
     chunk: &'a mut Chunk<V>,
     band_rows: u32,
@@ -322,11 +341,12 @@ impl<V: Copy> EmitPiece<V> for Binner<'_, V> {
             return;
         }
         let c = &mut *self.chunk;
-        let i = c.records.len() as u32;
         c.records.push(*p);
         let rows = self.band_rows;
+        // Bands fit 16 bits: a target is at most 2^16 rows and a band at least 8.
+        c.spans.push([(b.y0 / rows) as u16, (b.y1 / rows) as u16]);
         for band in b.y0 / rows..b.y1 / rows + 1 {
-            c.bins[band as usize].push(i);
+            c.starts[band as usize + 1] += 1;
             let y0 = b.y0.max(band * rows);
             let y1 = b.y1.min(band * rows + rows - 1);
             c.cost[band as usize] += u64::from((y1 - y0 + 1) * b.width()) + RECORD_COST;
@@ -357,16 +377,17 @@ pub(super) fn setup_chunk<S: Shader>(
     range: Range<u32>,
     chunk: &mut Chunk<S::Varying>,
 ) {
-    // Room for every triangle of the range in the records and in every bin (a piece
-    // per triangle unless clipping splits it): kept from draw to draw, so a model
-    // turning into new shapes does not grow them frame after frame.
+    // Room for a piece per triangle of the range (unless clipping splits one), each in
+    // two bands: kept from draw to draw, so a model turning into new shapes does not
+    // grow them frame after frame.
     let room = range.len();
     chunk.records.clear();
     chunk.records.reserve(room);
-    for b in &mut chunk.bins {
-        b.clear();
-        b.reserve(room);
-    }
+    chunk.entries.clear();
+    chunk.entries.reserve(2 * room);
+    chunk.spans.clear();
+    chunk.spans.reserve(room);
+    chunk.starts.fill(0);
     chunk.cost.fill(0);
     let mut stats = DrawStats::default();
     let mut binner = Binner {
@@ -387,6 +408,34 @@ pub(super) fn setup_chunk<S: Shader>(
         }
     }
     binner.chunk.stats = stats;
+    fill_bins(binner.chunk);
+}
+
+/// Places every record's index in the bins its box touches, once the records are
+/// counted per band: a counting sort, so each bin is in draw order.
+#[inline(always)]
+fn fill_bins<V>(c: &mut Chunk<V>) {
+    // Counts to starts: starts[b] is where band b's bin begins.
+    for b in 1..c.starts.len() {
+        c.starts[b] += c.starts[b - 1];
+    }
+    let total = c.starts.last().copied().unwrap_or(0) as usize;
+    c.entries.resize(total, 0);
+    // Each record at its band's next free place; starts[b] then holds the bin's end,
+    // which is where band b + 1's begins.
+    for (i, &[first, last]) in c.spans.iter().enumerate() {
+        for band in usize::from(first)..=usize::from(last) {
+            c.entries[c.starts[band] as usize] = i as u32;
+            c.starts[band] += 1;
+        }
+    }
+    // Back to starts.
+    for b in (1..c.starts.len()).rev() {
+        c.starts[b] = c.starts[b - 1];
+    }
+    if let Some(first) = c.starts.first_mut() {
+        *first = 0;
+    }
 }
 
 /// Walks band `band` (its rows of `color` and `depth`) through every chunk's bin in
@@ -412,7 +461,7 @@ pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
     let mut walker =
         PieceWalker::<S, C, L, V, _>::new(job.shader, depth, color, &job.opts, job.target);
     for chunk in chunks {
-        for &i in &chunk.bins[band] {
+        for &i in chunk.bin(band) {
             let tri = &chunk.records[i as usize];
             let b = tri.setup.bbox;
             let cut: Setup;
@@ -435,7 +484,30 @@ pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
 
 #[cfg(test)]
 mod tests {
-    use super::{BAND_ROWS, band_rows};
+    use super::{BAND_ROWS, Chunk, band_rows, fill_bins};
+
+    /// Each band's bin holds exactly the records whose span covers it, in draw order.
+    #[test]
+    fn bins_hold_each_band_s_records_in_order() {
+        let spans = [[0, 2], [1, 1], [2, 3], [0, 0], [3, 3], [1, 3]];
+        let mut c = Chunk::<()> {
+            starts: vec![0; 5],
+            spans: spans.to_vec(),
+            ..Chunk::default()
+        };
+        for &[a, b] in &spans {
+            for band in a..=b {
+                c.starts[usize::from(band) + 1] += 1;
+            }
+        }
+        fill_bins(&mut c);
+        for band in 0..4u16 {
+            let want: Vec<u32> = (0..spans.len() as u32)
+                .filter(|&i| (spans[i as usize][0]..=spans[i as usize][1]).contains(&band))
+                .collect();
+            assert_eq!(c.bin(usize::from(band)), want, "band {band}");
+        }
+    }
 
     /// Bands are whole blocks of 8 rows, at most `BAND_ROWS`, and about six per
     /// thread wherever the target is tall enough for that.

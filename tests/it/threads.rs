@@ -137,6 +137,25 @@ fn targets_smaller_than_a_band_draw_the_same_frame() {
     }
 }
 
+/// More threads than the bands hand-out serves (17), and a thread count that leaves
+/// some threads without a band of their own (5 on 8-row bands of a short target): one
+/// thread's frame.
+#[test]
+fn many_threads_draw_the_same_frame() {
+    let scene = model("bunny");
+    let view = turned(1.3);
+    for target in [Target::new(64, 30), Target::new(200, 300)] {
+        for isa in Isa::supported() {
+            let options = (Interpolation::Perspective, Traversal::Wide, isa);
+            let one = frame_bits(&scene, target, &view, options, 1);
+            for threads in [5, 17] {
+                let many = frame_bits(&scene, target, &view, options, threads);
+                assert!(one == many, "{target:?} {isa:?} on {threads} threads");
+            }
+        }
+    }
+}
+
 /// The probe, which recomputes a pixel from scratch on one thread, equals the frame
 /// drawn on two at every pixel.
 #[test]

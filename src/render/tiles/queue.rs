@@ -6,10 +6,12 @@ use rayon::prelude::*;
 
 use crate::render::options::DrawStats;
 
-/// The most bands a draw walks costliest first ([`plan_bands`]); a taller target's
-/// bands go to rayon's work stealing top to bottom. (The bands are handed out from
-/// an array of this size on the stack, so ordering them allocates nothing.)
-pub(super) const MAX_ORDERED_BANDS: usize = 96;
+/// The most bands a draw walks costliest first ([`plan_bands`]): as many as
+/// `band_rows` makes for [`MAX_QUEUES`] threads on a target up to 12 × 48 rows per
+/// thread; a taller target's bands go to rayon's work stealing top to bottom. (The
+/// bands are handed out from an array of this size on the stack, some 15 KB, so
+/// ordering them allocates nothing.)
+pub(super) const MAX_ORDERED_BANDS: usize = 12 * MAX_QUEUES;
 
 /// The most threads a draw hands bands to by [`Queues`]; with more, the bands go to
 /// rayon's work stealing in top-to-bottom order.
@@ -18,9 +20,9 @@ const MAX_QUEUES: usize = 16;
 /// Which band each thread walks next. Each thread has a home run of consecutive bands
 /// (as many as the others), which it walks costliest first; a thread whose run is done
 /// takes the cheapest band left in the longest other run. The costly bands are thus
-/// walked early and the cheap ones last, so the threads finish together; splitting by
-/// count rather than by cost keeps each thread on about the rows it had the frame
-/// before (measured: a split by cost is slower on the teapot).
+/// walked early and the cheap ones last, so the threads finish together. The runs are
+/// cut by count rather than by cost, so they stay the same from frame to frame
+/// (measured: a split by cost is slower on the teapot).
 #[derive(Debug, PartialEq, Eq)]
 pub(super) struct Queues {
     /// Per thread, the next and the end position of its run in the band order.

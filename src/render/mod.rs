@@ -113,9 +113,9 @@ pub const FUSED_PROJECTION_VERTICES: usize = 1 << 16;
 /// set-up and binning, which many small triangles make the larger part.
 pub const TRIANGLE_WORK: u64 = 32;
 
-/// The default [`Renderer::min_threaded_work`]: a megapixel, or some 32 000
+/// The default [`Renderer::min_threaded_work`]: half a megapixel, or some 16 000
 /// triangles.
-pub const MIN_THREADED_WORK: u64 = 1 << 20;
+pub const MIN_THREADED_WORK: u64 = 1 << 19;
 
 impl Renderer {
     /// A renderer for a target size.

@@ -6,11 +6,11 @@ use rayon::prelude::*;
 
 use crate::render::options::DrawStats;
 
-/// The most bands a draw walks costliest first ([`plan_bands`]): as many as
-/// `band_rows` makes for [`MAX_QUEUES`] threads on a target up to 12 × 48 rows per
-/// thread; a taller target's bands go to rayon's work stealing top to bottom. (The
+/// The most bands a draw walks costliest first ([`plan_bands`]): twelve per thread
+/// for [`MAX_QUEUES`] threads, the most `band_rows` makes while its bands are under
+/// 48 rows; more (a very tall target) go to rayon's work stealing top to bottom. The
 /// bands are handed out from an array of this size on the stack, some 15 KB, so
-/// ordering them allocates nothing.)
+/// ordering them allocates nothing.
 pub(super) const MAX_ORDERED_BANDS: usize = 12 * MAX_QUEUES;
 
 /// The most threads a draw hands bands to by [`Queues`]; with more, the bands go to

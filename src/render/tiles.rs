@@ -429,10 +429,8 @@ fn fill_bins<V>(c: &mut Chunk<V>) {
             c.starts[band] += 1;
         }
     }
-    // Back to starts.
-    for b in (1..c.starts.len()).rev() {
-        c.starts[b] = c.starts[b - 1];
-    }
+    // Back to starts (the last, the total, was never moved and rotates to the front).
+    c.starts.rotate_right(1);
     if let Some(first) = c.starts.first_mut() {
         *first = 0;
     }

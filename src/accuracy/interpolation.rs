@@ -10,6 +10,7 @@ use super::workloads::{Scene3, UvShader};
 use super::{Config, Errors, Family, Row};
 use crate::raster::Target;
 use crate::raster::interp::Interpolation;
+use crate::render::target::split_slice;
 use crate::render::{ColorTarget, DrawOptions, Renderer, VertexCache, transform};
 
 /// Texture coordinates per pixel (NaN where nothing was drawn).
@@ -33,6 +34,10 @@ impl ColorTarget for UvTarget {
 
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = UvRows<'_>> {
         self.0.par_chunks_mut(pixels).map(UvRows)
+    }
+
+    fn split_rows<'s>(&'s mut self, ends: &[usize], mut f: impl FnMut(UvRows<'s>)) {
+        split_slice(&mut self.0[..], ends, |p| f(UvRows(p)));
     }
 }
 
@@ -58,6 +63,10 @@ impl ColorTarget for UvRows<'_> {
 
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = UvRows<'_>> {
         self.0.par_chunks_mut(pixels).map(UvRows)
+    }
+
+    fn split_rows<'s>(&'s mut self, ends: &[usize], mut f: impl FnMut(UvRows<'s>)) {
+        split_slice(&mut self.0[..], ends, |p| f(UvRows(p)));
     }
 }
 

@@ -298,15 +298,24 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
     let frames = args.frames.max(1);
     let mut times = Vec::with_capacity(frames as usize);
     let mut covered = 0u64;
-    for n in 0..frames {
-        let view = SceneView {
-            yaw: n as f32 * RADIANS_PER_FRAME,
-            ..SceneView::default()
-        };
-        let start = Instant::now();
-        frame.draw(&scene, target, &view);
-        times.push(start.elapsed().as_secs_f64() * 1e3);
-        covered += frame.stats.fragments;
+    let pool = frame.renderer.thread_pool().cloned();
+    let mut run = || {
+        for n in 0..frames {
+            let view = SceneView {
+                yaw: n as f32 * RADIANS_PER_FRAME,
+                ..SceneView::default()
+            };
+            let start = Instant::now();
+            frame.draw(&scene, target, &view);
+            times.push(start.elapsed().as_secs_f64() * 1e3);
+            covered += frame.stats.fragments;
+        }
+    };
+    // The loop on the drawing threads, as the viewer runs it: no frame is handed from
+    // thread to thread.
+    match pool {
+        Some(pool) => pool.install(run),
+        None => run(),
     }
     times.sort_by(f64::total_cmp);
     let opts = frame.draw_options(&scene.plan.objects[0]);

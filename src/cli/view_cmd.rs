@@ -177,15 +177,18 @@ pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
             )
         })
     });
-    crate::tui::run(
-        app,
-        crate::tui::RunOptions {
-            fps: args.fps,
-            max_rate: args.max_rate,
-            paced: !args.no_pacing,
-            ask_palette: args.look.palette == PaletteArg::Auto,
-        },
-    )?;
+    let options = crate::tui::RunOptions {
+        fps: args.fps,
+        max_rate: args.max_rate,
+        paced: !args.no_pacing,
+        ask_palette: args.look.palette == PaletteArg::Auto,
+    };
+    // The viewer's loop on the drawing threads: no frame is handed from thread to
+    // thread, and small frames can be shared too (`Renderer::plan_frame`).
+    match app.scene.frame.renderer.thread_pool().cloned() {
+        Some(pool) => pool.install(|| crate::tui::run(app, options))?,
+        None => crate::tui::run(app, options)?,
+    }
     Ok(())
 }
 

@@ -294,6 +294,45 @@ impl DepthBuffer {
         }
     }
 
+    /// The buffer cut into bands ending at rows `ends` (ascending, each a multiple of
+    /// [`TILE_H`] but the last, which is the height), each handed to `f`:
+    /// [`DepthBuffer::bands`] of different heights.
+    pub(crate) fn split_rows<'s>(&'s mut self, ends: &[u32], mut f: impl FnMut(DepthRows<'s>)) {
+        let (width, words) = (self.width, self.words);
+        let storage = self.has_storage() && width > 0;
+        let (mut data, mut stale) = if storage {
+            (&mut self.data[..], &mut self.stale[..])
+        } else {
+            (&mut [][..], &mut [][..])
+        };
+        let mut y0 = 0;
+        for &end in ends {
+            let end = end.min(self.height).max(y0);
+            let rows = end - y0;
+            debug_assert!(y0.is_multiple_of(TILE_H), "a band from row {y0}");
+            let (px, bits) = if storage {
+                (
+                    rows as usize * width as usize,
+                    rows.div_ceil(TILE_H) as usize * words,
+                )
+            } else {
+                (0, 0)
+            };
+            let (px, bits) = (px.min(data.len()), bits.min(stale.len()));
+            let (d, d_rest) = std::mem::take(&mut data).split_at_mut(px);
+            let (b, b_rest) = std::mem::take(&mut stale).split_at_mut(bits);
+            f(DepthRows {
+                data: d,
+                stale: b,
+                words: if storage { words } else { 0 },
+                width,
+                y0,
+                rows,
+            });
+            (data, stale, y0) = (d_rest, b_rest, end);
+        }
+    }
+
     /// The values, row-major, for writers that filled the stale tiles they touch first.
     #[inline(always)]
     pub(crate) fn filled_mut(&mut self) -> &mut [f32] {

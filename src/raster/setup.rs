@@ -372,6 +372,14 @@ pub fn box_holds(v: &[[i64; 2]; 3], x: u32, y: u32) -> bool {
     (x0..=x1).contains(&i64::from(x)) && (y0..=y1).contains(&i64::from(y))
 }
 
+/// The first and last row of the box of a triangle with snapped vertices `v`,
+/// unclamped to any target: [`Setup::bbox`]'s rows, without the set-up.
+#[inline(always)]
+#[must_use]
+pub fn box_rows(v: &[[i64; 2]; 3]) -> [i64; 2] {
+    centre_span(v)[1]
+}
+
 /// Pixels whose centres lie within the vertices' bounding box, clipped to the target.
 #[inline(always)]
 fn pixel_bounds(v: &[[i64; 2]; 3], target: Target) -> Option<PixelRect> {

@@ -145,7 +145,7 @@ pub(super) fn run<S: Shader, C: ColorTarget>(
 ) {
     // `S::THREADED` first, as its own condition: a constant `false` keeps the threaded
     // copies from being compiled for the shader.
-    if S::THREADED && r.threaded() {
+    if S::THREADED && r.spread() != super::Spread::One {
         run_tiled(copy, r, shader, cache, indices, opts, color);
         return;
     }
@@ -252,7 +252,7 @@ pub(super) mod baseline {
 
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
-    use crate::render::tiles::{self, Chunk, Job, TileCopy};
+    use crate::render::tiles::{self, Chunk, Job, TileCopy, strips};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
     /// The threaded draw's steps of variant `V` on [`wide`]'s portable lanes.
@@ -275,6 +275,16 @@ pub(super) mod baseline {
             clear: Option<Vec3>,
         ) -> DrawStats {
             tiles::walk_band::<V, S, C, wide::i32x8>(job, chunks, band, color, depth, clear)
+        }
+        unsafe fn strip<S: Shader, C: ColorTarget>(
+            job: &Job<'_, S>,
+            ends: &[u32],
+            strip: usize,
+            color: &mut C,
+            depth: &mut DepthRows<'_>,
+            clear: Option<Vec3>,
+        ) -> DrawStats {
+            strips::draw_strip::<V, S, C, wide::i32x8>(job, ends, strip, color, depth, clear)
         }
     }
 
@@ -302,7 +312,7 @@ pub(super) mod avx2 {
 
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
-    use crate::render::tiles::{self, Chunk, Job, TileCopy};
+    use crate::render::tiles::{self, Chunk, Job, TileCopy, strips};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
     /// The threaded draw's steps of variant `V`, compiled as [`draw`] is.
@@ -327,6 +337,17 @@ pub(super) mod avx2 {
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
             unsafe { walk::<V, S, C>(job, chunks, band, color, depth, clear) }
+        }
+        unsafe fn strip<S: Shader, C: ColorTarget>(
+            job: &Job<'_, S>,
+            ends: &[u32],
+            strip: usize,
+            color: &mut C,
+            depth: &mut DepthRows<'_>,
+            clear: Option<Vec3>,
+        ) -> DrawStats {
+            // SAFETY: the caller's guarantee.
+            unsafe { self::strip::<V, S, C>(job, ends, strip, color, depth, clear) }
         }
     }
 
@@ -354,6 +375,24 @@ pub(super) mod avx2 {
     ) -> DrawStats {
         tiles::walk_band::<V, S, C, crate::simd::avx2::I32x8>(
             job, chunks, band, color, depth, clear,
+        )
+    }
+
+    /// [`strips::draw_strip`] on the AVX2 lanes.
+    ///
+    /// # Safety
+    /// As for [`draw`].
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1")]
+    unsafe fn strip<V: DrawVariant, S: Shader, C: ColorTarget>(
+        job: &Job<'_, S>,
+        ends: &[u32],
+        strip: usize,
+        color: &mut C,
+        depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
+    ) -> DrawStats {
+        strips::draw_strip::<V, S, C, crate::simd::avx2::I32x8>(
+            job, ends, strip, color, depth, clear,
         )
     }
 
@@ -389,7 +428,7 @@ pub(super) mod avx512 {
 
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
-    use crate::render::tiles::{self, Chunk, Job, TileCopy};
+    use crate::render::tiles::{self, Chunk, Job, TileCopy, strips};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
     /// The threaded draw's steps, compiled as [`draw`] is.
@@ -414,6 +453,17 @@ pub(super) mod avx512 {
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
             unsafe { walk::<S, C>(job, chunks, band, color, depth, clear) }
+        }
+        unsafe fn strip<S: Shader, C: ColorTarget>(
+            job: &Job<'_, S>,
+            ends: &[u32],
+            strip: usize,
+            color: &mut C,
+            depth: &mut DepthRows<'_>,
+            clear: Option<Vec3>,
+        ) -> DrawStats {
+            // SAFETY: the caller's guarantee.
+            unsafe { self::strip::<S, C>(job, ends, strip, color, depth, clear) }
         }
     }
 
@@ -441,6 +491,24 @@ pub(super) mod avx512 {
     ) -> DrawStats {
         tiles::walk_band::<Fast, S, C, crate::simd::avx512::I32x16>(
             job, chunks, band, color, depth, clear,
+        )
+    }
+
+    /// [`strips::draw_strip`] on 16 AVX-512 lanes in two-row groups.
+    ///
+    /// # Safety
+    /// As for [`draw`].
+    #[target_feature(enable = "avx2,fma,popcnt,bmi1,avx512f,avx512vl,avx512bw,avx512dq")]
+    unsafe fn strip<S: Shader, C: ColorTarget>(
+        job: &Job<'_, S>,
+        ends: &[u32],
+        strip: usize,
+        color: &mut C,
+        depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
+    ) -> DrawStats {
+        strips::draw_strip::<Fast, S, C, crate::simd::avx512::I32x16>(
+            job, ends, strip, color, depth, clear,
         )
     }
 

@@ -10,7 +10,7 @@
 //! | `fragments` | the coverage sink that tests depth and shades |
 //! | [`probe`](mod@probe) | one pixel's raster state, recomputed on demand |
 //! | `isa` | the compiled copies of the draw loop and the one choice among them |
-//! | `tiles` | drawing on several threads: set-up binned by bands of rows, each band walked in draw order (`tiles/queue`: which thread walks which band) |
+//! | `tiles` | drawing on several threads: set-up binned by bands of rows, each band walked in draw order (`tiles/queue`: which thread walks which band); small frames a strip of rows per thread (`tiles/strips`) |
 //! | this file | [`Renderer`]: frame state and the triangle loop |
 //!
 //! Screen mapping ([`ndc_to_screen`]): NDC x ∈ [−1, 1] maps to pixels [0, width] left
@@ -53,7 +53,7 @@ pub mod probe;
 pub mod shader;
 pub mod shaders;
 pub mod target;
-mod tiles;
+pub mod tiles;
 pub mod wire;
 
 use std::sync::Arc;
@@ -74,6 +74,7 @@ pub use prepare::{
 };
 pub use shader::{ShadeLanes, Shader};
 pub use target::{ColorTarget, Rgba8, Rgba8Rows};
+pub use tiles::strips::{MAX_STRIPS, strip_ends};
 pub use tiles::{BAND_ROWS, band_rows};
 
 /// Owns the depth buffer and frame counters; draws meshes into a colour target.
@@ -95,12 +96,19 @@ pub struct Renderer {
     pending_clear: Option<Vec3>,
     /// The least work (pixels + [`TRIANGLE_WORK`] × triangles) a draw must have to
     /// run on several threads: below it, handing the draw out costs more than the
-    /// second thread saves (a model at terminal size). Tests set 0.
+    /// second thread saves. Tests set 0.
     pub min_threaded_work: u64,
-    /// Whether the current draw runs on several threads.
-    threaded: bool,
+    /// The least work a draw must have to run on several threads at all: from here
+    /// to [`Renderer::min_threaded_work`], a strip of rows per thread
+    /// ([`Spread::Strips`]), if the caller runs on the pool ([`Renderer::plan_frame`]);
+    /// below it, the draw is too short for the threads to meet in time. Tests set 0.
+    pub min_strip_work: u64,
+    /// How the current draw is shared among threads.
+    spread: Spread,
     /// Whether this frame may use the pool at all ([`Renderer::plan_frame`]).
     frame_threads: bool,
+    /// Whether this frame is worth binning ([`Spread::Bins`]).
+    frame_bins: bool,
 }
 
 /// The fewest vertices the one-thread vertex stage projects in its own pass
@@ -117,6 +125,21 @@ pub const TRIANGLE_WORK: u64 = 32;
 /// triangles.
 pub const MIN_THREADED_WORK: u64 = 1 << 19;
 
+/// The default [`Renderer::min_strip_work`].
+pub const MIN_STRIP_WORK: u64 = 1 << 16;
+
+/// How a draw is shared among the renderer's threads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Spread {
+    /// On the calling thread alone.
+    One,
+    /// A strip of rows per thread, each setting up the triangles that reach it
+    /// (`tiles/strips`): for draws of less than [`Renderer::min_threaded_work`].
+    Strips,
+    /// Set up once and binned by bands of rows, then walked band by band (`tiles`).
+    Bins,
+}
+
 impl Renderer {
     /// A renderer for a target size.
     #[must_use]
@@ -131,8 +154,10 @@ impl Renderer {
             scratch: tiles::Scratch::default(),
             pending_clear: None,
             min_threaded_work: MIN_THREADED_WORK,
-            threaded: false,
+            min_strip_work: MIN_STRIP_WORK,
+            spread: Spread::One,
             frame_threads: true,
+            frame_bins: true,
         }
     }
 
@@ -164,9 +189,25 @@ impl Renderer {
 
     /// Says how much work the coming frame has in all (pixels + [`TRIANGLE_WORK`] ×
     /// triangles): a frame below [`Renderer::min_threaded_work`] runs wholly on the
-    /// calling thread, vertices and clears included, as if there were no pool.
+    /// calling thread, vertices and clears included, as if there were no pool, unless
+    /// the calling thread is one of the pool's ([`Renderer::thread_pool`]) and the
+    /// frame has at least [`Renderer::min_strip_work`]: then its draws are shared in
+    /// strips ([`Spread::Strips`]).
     pub fn plan_frame(&mut self, work: u64) {
-        self.frame_threads = work >= self.min_threaded_work;
+        let on_pool = self
+            .pool
+            .as_ref()
+            .is_some_and(|p| p.current_thread_index().is_some());
+        self.frame_bins = work >= self.min_threaded_work;
+        self.frame_threads = self.frame_bins || (on_pool && work >= self.min_strip_work);
+    }
+
+    /// The renderer's threads, if more than one, whatever the frame: a caller that
+    /// runs its frame loop inside (`install`) hands no frame from thread to thread,
+    /// and lets small frames be shared too ([`Renderer::plan_frame`]).
+    #[must_use]
+    pub fn thread_pool(&self) -> Option<&Arc<rayon::ThreadPool>> {
+        self.pool.as_ref()
     }
 
     /// The pool this frame's work runs on, if more than one thread and the frame is
@@ -259,7 +300,11 @@ impl Renderer {
     /// Clears the colour target if a deferred clear is still pending (no draw of the
     /// frame took it), on the renderer's threads.
     pub fn finish_clear<C: ColorTarget>(&mut self, color: &mut C) {
-        let (Some(background), Some(pool)) = (self.pending_clear.take(), self.pool()) else {
+        let Some(background) = self.pending_clear.take() else {
+            return;
+        };
+        let Some(pool) = self.pool() else {
+            color.reset(self.target.len(), background);
             return;
         };
         use rayon::prelude::*;
@@ -276,12 +321,13 @@ impl Renderer {
     /// Whether draws run on several threads ([`tiles`]): with a pool, on a target
     /// with pixels.
     fn tiled(&self) -> bool {
-        self.pool().is_some() && !self.target.is_empty()
+        self.pool.is_some() && self.frame_threads && !self.target.is_empty()
     }
 
-    /// Whether the current draw runs on several threads (set by [`Renderer::draw`]).
-    pub(super) fn threaded(&self) -> bool {
-        self.threaded
+    /// How the current draw is shared among threads (set by [`Renderer::draw`]).
+    #[must_use]
+    pub fn spread(&self) -> Spread {
+        self.spread
     }
 
     /// Whether this frame has a depth buffer.
@@ -304,8 +350,13 @@ impl Renderer {
             self.depth.reset(self.target.width, self.target.height);
         }
         let work = self.target.len() as u64 + TRIANGLE_WORK * (indices.len() / 3) as u64;
-        self.threaded = S::THREADED && self.tiled() && work >= self.min_threaded_work;
-        if !self.threaded {
+        self.spread = match () {
+            _ if !S::THREADED || !self.tiled() => Spread::One,
+            _ if self.frame_bins && work >= self.min_threaded_work => Spread::Bins,
+            _ if work >= self.min_strip_work => Spread::Strips,
+            _ => Spread::One,
+        };
+        if self.spread == Spread::One {
             self.finish_clear(color);
         }
         let copy = self.copy_for::<S>(opts);

@@ -13,7 +13,7 @@ use crate::raster::clip::{
     ClipOutcome, ClipVertex, classify_codes, clip_straddling, guard_band_ndc, outcode,
 };
 use crate::raster::interp::Varying;
-use crate::raster::setup::{box_holds, snap};
+use crate::raster::setup::{box_holds, box_rows, snap};
 use crate::raster::{SUBPIXEL_BITS, Setup, Target};
 use crate::simd::each3;
 
@@ -186,6 +186,26 @@ impl Projected {
             z: pos.z * inv_w,
             fixed: [sx.unwrap_or(0), sy.unwrap_or(0)],
         }
+    }
+
+    /// The pixel row of a vertex inside every plane and snapped (unclamped to the
+    /// target): where a frame's work lies, for sharing its rows among threads.
+    #[inline(always)]
+    #[must_use]
+    pub(crate) fn row(&self) -> Option<i64> {
+        (self.out == 0 && self.snapped).then_some(self.fixed[1] >> SUBPIXEL_BITS)
+    }
+
+    /// The first and last row of the box of a triangle of these vertices (unclamped
+    /// to the target) if it is drawn unclipped (inside every plane, every vertex
+    /// snapped); `None` for one that needs clipping or is rejected, whose rows only
+    /// [`prepare_projected`] knows.
+    #[inline(always)]
+    #[must_use]
+    pub(crate) fn unclipped_rows(pv: [Self; 3]) -> Option<[i64; 2]> {
+        let inside = classify_codes(each3!(|i| pv[i].out)) == ClipOutcome::Inside;
+        (inside && pv[0].snapped && pv[1].snapped && pv[2].snapped)
+            .then(|| box_rows(&each3!(|i| pv[i].fixed)))
     }
 
     /// Whether a triangle of these vertices surely leaves pixel `(x, y)` alone: it is

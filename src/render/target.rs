@@ -53,6 +53,24 @@ pub trait ColorTarget: Send {
     /// The target in bands of `pixels` pixels each (the last may be shorter), first
     /// to last: disjoint borrows, so threads can write them at once.
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = Self::Rows<'_>>;
+
+    /// The target cut into bands of rows of different heights, ending at pixels
+    /// `ends` (ascending, clamped to the target), first to last, each handed to `f`:
+    /// disjoint borrows, for draws that share the rows unevenly among threads.
+    fn split_rows<'s>(&'s mut self, ends: &[usize], f: impl FnMut(Self::Rows<'s>));
+}
+
+/// Cuts `rest` at `ends` (ascending, clamped to its length), handing each piece to `f`
+/// in order: [`ColorTarget::split_rows`] for targets held in slices.
+pub fn split_slice<'s, T>(mut rest: &'s mut [T], ends: &[usize], mut f: impl FnMut(&'s mut [T])) {
+    let mut at = 0;
+    for &end in ends {
+        let len = end.saturating_sub(at).min(rest.len());
+        let (piece, tail) = std::mem::take(&mut rest).split_at_mut(len);
+        f(piece);
+        rest = tail;
+        at += len;
+    }
 }
 
 /// 8-bit RGBA. Alpha records coverage: the background is cleared with alpha 0 and
@@ -167,6 +185,10 @@ impl ColorTarget for Rgba8 {
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = Rgba8Rows<'_>> {
         self.0.par_chunks_mut(pixels).map(Rgba8Rows)
     }
+
+    fn split_rows<'s>(&'s mut self, ends: &[usize], mut f: impl FnMut(Rgba8Rows<'s>)) {
+        split_slice(&mut self.0[..], ends, |p| f(Rgba8Rows(p)));
+    }
 }
 
 /// A band of rows of an [`Rgba8`] target (see [`ColorTarget::bands`]).
@@ -202,6 +224,10 @@ impl ColorTarget for Rgba8Rows<'_> {
 
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = Rgba8Rows<'_>> {
         self.0.par_chunks_mut(pixels).map(Rgba8Rows)
+    }
+
+    fn split_rows<'s>(&'s mut self, ends: &[usize], mut f: impl FnMut(Rgba8Rows<'s>)) {
+        split_slice(&mut self.0[..], ends, |p| f(Rgba8Rows(p)));
     }
 }
 

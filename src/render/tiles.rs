@@ -1,6 +1,7 @@
 //! Drawing on several threads, with the frame one thread would draw, bit for bit.
 //!
-//! A draw runs in three parallel steps on the renderer's thread pool:
+//! A small draw is shared in strips of rows, one step (`strips`). A larger one runs
+//! in three parallel steps on the renderer's thread pool:
 //!
 //! 1. **Vertices**: every vertex goes through the vertex stage and is projected once
 //!    ([`Projected::of`]), in parallel chunks of the vertex array, in one pass
@@ -35,7 +36,6 @@ use std::ops::Range;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::Renderer;
 use super::fragments::PieceWalker;
 use super::isa::DrawVariant;
 use super::options::{DrawOptions, DrawStats};
@@ -44,6 +44,7 @@ use super::prepare::{
 };
 use super::shader::Shader;
 use super::target::ColorTarget;
+use super::{Renderer, Spread};
 use crate::raster::clip::guard_band_ndc;
 use crate::raster::depth::DepthRows;
 use crate::raster::{Setup, Target};
@@ -51,6 +52,7 @@ use crate::simd::I32s;
 use queue::plan_bands;
 
 mod queue;
+pub mod strips;
 
 /// The tallest band: a multiple of the block traversal's 8 and of the depth clear
 /// tile. Chosen by measurement (see `docs/performance.md`).
@@ -132,6 +134,8 @@ pub(super) struct Scratch {
     order: Vec<u32>,
     /// Per band, the work of the batch being walked.
     cost: Vec<u64>,
+    /// Per 8 rows, the vertices there (`strips`: where a small frame's work lies).
+    pub(super) rows: Vec<u32>,
 }
 
 impl std::fmt::Debug for Scratch {
@@ -206,14 +210,54 @@ pub(super) trait TileCopy {
         depth: &mut DepthRows<'_>,
         clear: Option<Vec3>,
     ) -> DrawStats;
+
+    /// Draws strip `strip` (of those ending at rows `ends`) of every triangle into its
+    /// rows of colour and depth, first
+    /// filling the colour rows with `clear` if given (see [`strips::draw_strip`]);
+    /// returns its counters.
+    ///
+    /// # Safety
+    /// As for [`TileCopy::setup`].
+    unsafe fn strip<S: Shader, C: ColorTarget>(
+        job: &Job<'_, S>,
+        ends: &[u32],
+        strip: usize,
+        color: &mut C,
+        depth: &mut DepthRows<'_>,
+        clear: Option<Vec3>,
+    ) -> DrawStats;
 }
 
-/// Draws on the renderer's pool with copy `T`: the threaded form of
-/// `Renderer::draw_triangles`, with the same frame and counters.
+/// Draws on the renderer's pool with copy `T`, in strips or in bins as the renderer
+/// chose for the draw ([`super::Spread`]).
 ///
 /// # Safety
 /// The CPU must have `T`'s instruction set (as [`super::DrawCopy::choose`] ensures).
 pub(super) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
+    r: &mut Renderer,
+    shader: &S,
+    cache: &VertexCache<S::Varying>,
+    indices: &[u32],
+    opts: &DrawOptions,
+    color: &mut C,
+) {
+    // SAFETY: the caller's guarantee.
+    unsafe {
+        if r.spread() == Spread::Strips {
+            strips::draw::<T, S, C>(r, shader, cache, indices, opts, color);
+        } else {
+            draw_binned::<T, S, C>(r, shader, cache, indices, opts, color);
+        }
+    }
+}
+
+/// Draws on the renderer's pool with copy `T`, set up and binned, then walked by
+/// bands: the threaded form of `Renderer::draw_triangles`, with the same frame and
+/// counters.
+///
+/// # Safety
+/// As for [`draw`].
+unsafe fn draw_binned<T: TileCopy, S: Shader, C: ColorTarget>(
     r: &mut Renderer,
     shader: &S,
     cache: &VertexCache<S::Varying>,

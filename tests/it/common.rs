@@ -3,6 +3,7 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use termrast::raster::{CountGrid, CoverageSink, Setup, Target, Traversal, oracle};
+use termrast::render::target::split_slice;
 use termrast::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache, transform};
 
 /// A sink that checks every reported pixel lies in the target and the bbox.
@@ -116,6 +117,16 @@ impl ColorTarget for Exact {
         (self.colors.par_chunks_mut(pixels).zip(writes))
             .map(|(colors, writes)| ExactRows { colors, writes })
     }
+
+    fn split_rows<'s>(&'s mut self, ends: &[usize], mut f: impl FnMut(ExactRows<'s>)) {
+        let mut writes = Vec::new();
+        split_slice(&mut self.writes[..], ends, |w| writes.push(w));
+        let mut writes = writes.into_iter();
+        split_slice(&mut self.colors[..], ends, |colors| {
+            let writes = writes.next().expect("as many pieces as colours");
+            f(ExactRows { colors, writes });
+        });
+    }
 }
 
 /// A band of rows of an [`Exact`] target: a write outside the band fails the test.
@@ -151,6 +162,16 @@ impl ColorTarget for ExactRows<'_> {
         let writes = self.writes.par_chunks_mut(pixels);
         (self.colors.par_chunks_mut(pixels).zip(writes))
             .map(|(colors, writes)| ExactRows { colors, writes })
+    }
+
+    fn split_rows<'s>(&'s mut self, ends: &[usize], mut f: impl FnMut(ExactRows<'s>)) {
+        let mut writes = Vec::new();
+        split_slice(&mut self.writes[..], ends, |w| writes.push(w));
+        let mut writes = writes.into_iter();
+        split_slice(&mut self.colors[..], ends, |colors| {
+            let writes = writes.next().expect("as many pieces as colours");
+            f(ExactRows { colors, writes });
+        });
     }
 }
 

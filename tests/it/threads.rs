@@ -1,8 +1,9 @@
-//! Drawing on several threads: the frame (colour and depth bits) and the counters
-//! equal one thread's for every model and scene, traversal, interpolation mode and
-//! instruction set, on targets smaller than a band and across bands; the probe still
-//! equals the framebuffer; triangles crossing a band's border at every subpixel
-//! offset, and random ones, draw the same fragments in the same order.
+//! Drawing on several threads, binned by bands or in strips: the frame (colour and
+//! depth bits) and the counters equal one thread's for every model and scene,
+//! traversal, interpolation mode and instruction set, on targets smaller than a band
+//! and across bands and strips; the probe still equals the framebuffer; triangles
+//! crossing a band's or a strip's border at every subpixel offset, and random ones,
+//! draw the same fragments in the same order.
 
 use glam::{Vec3, Vec4};
 use proptest::prelude::*;
@@ -11,7 +12,10 @@ use termrast::raster::interp::Interpolation;
 use termrast::raster::{Target, Traversal};
 use termrast::render::probe::DepthOutcome;
 use termrast::render::target::to_u8;
-use termrast::render::{BAND_ROWS, DrawOptions, DrawStats, Isa, Renderer, VertexCache, band_rows};
+use termrast::render::{
+    BAND_ROWS, DrawOptions, DrawStats, Isa, Renderer, Spread, VertexCache, band_rows,
+    project_vertices, strip_ends,
+};
 use termrast::scene::Scene;
 use termrast::scene::render::{SceneFrame, SceneView};
 
@@ -20,22 +24,44 @@ use crate::common::{Direct, Exact};
 /// A frame's colour, depth bits and counters.
 type Bits = (Vec<[u8; 4]>, Vec<u32>, DrawStats);
 
-/// One frame of `scene` drawn on `threads` threads.
+/// The ways draws are shared among threads.
+const WAYS: [Spread; 2] = [Spread::Bins, Spread::Strips];
+
+/// Sets the thresholds so that every draw of `r` with threads is shared `way`.
+fn share(r: &mut Renderer, way: Spread) {
+    match way {
+        Spread::Bins => r.min_threaded_work = 0,
+        _ => {
+            r.min_threaded_work = u64::MAX;
+            r.min_strip_work = 0;
+        }
+    }
+}
+
+/// One frame of `scene` drawn on `threads` threads, shared `way`; the frame runs on
+/// the pool's threads, as the viewer's does (which strips need).
 fn frame_bits(
     scene: &Scene,
     target: Target,
     view: &SceneView,
     (interpolation, traversal, isa): (Interpolation, Traversal, Isa),
     threads: usize,
+    way: Spread,
 ) -> Bits {
     let mut frame = SceneFrame::new(scene);
     frame.renderer.isa = isa;
     frame.renderer.set_threads(threads);
-    frame.renderer.min_threaded_work = 0;
+    share(&mut frame.renderer, way);
     assert_eq!(frame.renderer.threads(), threads);
     frame.interpolation = interpolation;
     frame.traversal = traversal;
-    frame.draw(scene, target, view);
+    match frame.renderer.thread_pool().cloned() {
+        Some(pool) => pool.install(|| frame.draw(scene, target, view)),
+        None => frame.draw(scene, target, view),
+    }
+    if threads > 1 {
+        assert_eq!(frame.renderer.spread(), way, "{target:?}");
+    }
     let depth = frame.renderer.depth.to_vec();
     let depth = depth.iter().map(|d| d.to_bits()).collect();
     (frame.color.0, depth, frame.stats)
@@ -89,11 +115,16 @@ fn threaded_frames_equal_one_thread_for_every_model_option_and_isa() {
     for (name, scene) in &scenes {
         let view = turned(0.9);
         for options in every_option() {
-            let one = frame_bits(scene, target, &view, options, 1);
+            let one = frame_bits(scene, target, &view, options, 1, Spread::One);
             assert!(one.2.shaded > 500, "{name} covers the frame");
             for threads in [2, 3] {
-                let many = frame_bits(scene, target, &view, options, threads);
-                assert!(one == many, "{name} {options:?} on {threads} threads");
+                for way in WAYS {
+                    let many = frame_bits(scene, target, &view, options, threads, way);
+                    assert!(
+                        one == many,
+                        "{name} {options:?} on {threads} threads, {way:?}"
+                    );
+                }
             }
         }
     }
@@ -130,9 +161,11 @@ fn targets_smaller_than_a_band_draw_the_same_frame() {
     ] {
         let target = Target::new(w, h);
         for options in every_option() {
-            let one = frame_bits(&scene, target, &view, options, 1);
-            let two = frame_bits(&scene, target, &view, options, 2);
-            assert!(one == two, "{w}x{h} {options:?}");
+            let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
+            for way in WAYS {
+                let two = frame_bits(&scene, target, &view, options, 2, way);
+                assert!(one == two, "{w}x{h} {options:?} {way:?}");
+            }
         }
     }
 }
@@ -147,10 +180,15 @@ fn many_threads_draw_the_same_frame() {
     for target in [Target::new(64, 30), Target::new(200, 300)] {
         for isa in Isa::supported() {
             let options = (Interpolation::Perspective, Traversal::Wide, isa);
-            let one = frame_bits(&scene, target, &view, options, 1);
+            let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
             for threads in [5, 17] {
-                let many = frame_bits(&scene, target, &view, options, threads);
-                assert!(one == many, "{target:?} {isa:?} on {threads} threads");
+                for way in WAYS {
+                    let many = frame_bits(&scene, target, &view, options, threads, way);
+                    assert!(
+                        one == many,
+                        "{target:?} {isa:?} on {threads} threads {way:?}"
+                    );
+                }
             }
         }
     }
@@ -162,12 +200,19 @@ fn many_threads_draw_the_same_frame() {
 fn probe_equals_the_threaded_framebuffer() {
     let mut scene = model("bunny");
     let target = Target::new(120, 90);
-    for (angle, cull) in [(0.7f32, false), (2.1, true)] {
+    for (angle, cull, way) in [
+        (0.7f32, false, Spread::Bins),
+        (2.1, true, Spread::Bins),
+        (0.7, false, Spread::Strips),
+        (2.1, true, Spread::Strips),
+    ] {
         scene.set_cull(cull);
         let mut frame = SceneFrame::new(&scene);
         frame.renderer.set_threads(2);
-        frame.renderer.min_threaded_work = 0;
-        frame.draw(&scene, target, &turned(angle));
+        share(&mut frame.renderer, way);
+        let pool = frame.renderer.thread_pool().cloned().expect("two threads");
+        pool.install(|| frame.draw(&scene, target, &turned(angle)));
+        assert_eq!(frame.renderer.spread(), way);
         let mut winners = 0;
         for y in 0..target.height {
             for x in 0..target.width {
@@ -192,23 +237,26 @@ fn probe_equals_the_threaded_framebuffer() {
 /// bits and the counters.
 type Drawn = (Vec<Option<Vec3>>, Vec<u32>, Vec<u32>, DrawStats);
 
-/// Draws `shader`'s triangles on `threads` threads into an [`Exact`] target, which
-/// fails the test on a write outside the band being drawn.
+/// Draws `shader`'s triangles on `threads` threads, shared `way`, into an [`Exact`]
+/// target, which fails the test on a write outside the band or strip being drawn.
 fn draw_direct(
     shader: &Direct,
     indices: &[u32],
     target: Target,
     opts: &DrawOptions,
-    threads: usize,
+    (threads, way): (usize, Spread),
 ) -> Drawn {
     let mut r = Renderer::new(target);
     r.set_threads(threads);
-    r.min_threaded_work = 0;
+    share(&mut r, way);
     let mut out = Exact::default();
     let mut cache = VertexCache::default();
     r.begin_frame(target, &mut out, Vec3::ZERO);
     r.transform(shader, shader.clip.len(), &mut cache);
     r.draw(shader, &cache, indices, opts, &mut out);
+    if threads > 1 && !target.is_empty() {
+        assert_eq!(r.spread(), way);
+    }
     let depth = r.depth.to_vec().iter().map(|d| d.to_bits()).collect();
     (out.colors, out.writes, depth, r.stats)
 }
@@ -233,8 +281,9 @@ fn options(traversal: Traversal, interpolation: Interpolation, func: DepthFunc) 
 /// Triangles with a vertex on each side of the first band border, the border crossed
 /// at every one of the 256 subpixel offsets (and vertices exactly on it), overlapping
 /// at equal and unequal depths so the order of the writes shows: the same exact
-/// colours, writes per pixel, depth and counters on 1 and 2 threads, for every
-/// traversal; on a short target (the shortest bands) and a tall one (the tallest).
+/// colours, writes per pixel, depth and counters on 1 and 2 threads, binned or in
+/// strips (whose border unused vertices put on the same row), for every traversal;
+/// on a short target (the shortest bands) and a tall one (the tallest).
 #[test]
 fn triangles_crossing_a_band_border_at_every_subpixel_draw_the_same() {
     let short = Target::new(48, 45);
@@ -264,23 +313,41 @@ fn triangles_crossing_a_band_border_at_every_subpixel_draw_the_same() {
             p(30.0 + off, border, 0.4),
             p(17.0, border + 6.0 * off, 0.4),
         ];
+        // Unused vertices that end the first of two strips at the border: as many
+        // in the 8 rows above it as in the last 8 rows and the fan together.
+        let fan = clip.len();
+        let mut clip = clip;
+        clip.extend((0..1000).map(|_| p(1.0, border - 4.0, 0.5)));
+        let last = target.height as f32 - 2.0;
+        clip.extend((0..1000 - fan + 1).map(|_| p(1.0, last, 0.5)));
         let attr = (0..clip.len())
             .map(|i| Vec3::new(i as f32, off, 1.0 - off))
             .collect();
         let shader = Direct { clip, attr };
+        let mut cache = VertexCache::default();
+        termrast::render::transform(&shader, shader.clip.len(), &mut cache);
+        let mut pv = Vec::new();
+        project_vertices(&cache, target, &mut pv);
+        let ends = strip_ends(&pv, target.height, 2, &mut Vec::new()).0;
+        assert_eq!(
+            ends[0], border as u32,
+            "{target:?} {sub}: the strips' border"
+        );
         let indices = [
             0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1, 5, 6, 7, 8, 9, 10, 1, 3, 2,
         ];
         for traversal in Traversal::ALL {
             for func in [DepthFunc::Less, DepthFunc::LessEqual, DepthFunc::Always] {
                 let o = options(traversal, Interpolation::Perspective, func);
-                let one = draw_direct(&shader, &indices, target, &o, 1);
+                let one = draw_direct(&shader, &indices, target, &o, (1, Spread::One));
                 assert!(one.3.fragments > 100, "{sub}: the fan covers pixels");
-                let two = draw_direct(&shader, &indices, target, &o, 2);
-                assert!(
-                    one == two,
-                    "{target:?} subpixel {sub}, {traversal:?}, {func:?}"
-                );
+                for way in WAYS {
+                    let two = draw_direct(&shader, &indices, target, &o, (2, way));
+                    assert!(
+                        one == two,
+                        "{target:?} subpixel {sub}, {traversal:?}, {func:?}, {way:?}"
+                    );
+                }
             }
         }
     }
@@ -296,7 +363,8 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
     /// Random triangles, any traversal, interpolation and depth test, on targets
-    /// from one band to several: 1, 2 and 3 threads draw the same.
+    /// from one band to several: 1, 2 and 3 threads, binned or in strips, draw the
+    /// same.
     #[test]
     fn random_triangles_draw_the_same_on_every_thread_count(
         clip in prop::collection::vec(vertex(), 3..40),
@@ -314,10 +382,12 @@ proptest! {
         let attr = clip.iter().map(|p| p.truncate().abs()).collect();
         let shader = Direct { clip, attr };
         let o = options(traversal, interpolation, func);
-        let one = draw_direct(&shader, &indices, target, &o, 1);
+        let one = draw_direct(&shader, &indices, target, &o, (1, Spread::One));
         for threads in [2, 3] {
-            let many = draw_direct(&shader, &indices, target, &o, threads);
-            prop_assert!(one == many, "{} threads", threads);
+            for way in WAYS {
+                let many = draw_direct(&shader, &indices, target, &o, (threads, way));
+                prop_assert!(one == many, "{} threads, {:?}", threads, way);
+            }
         }
     }
 }

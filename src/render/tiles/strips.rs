@@ -1,0 +1,360 @@
+//! Small frames on several threads: one strip of rows per thread, each setting up
+//! every triangle that reaches its rows and walking it there at once.
+//!
+//! A frame of a few hundred thousand pixels and a few thousand triangles (a model at
+//! terminal size) is done in well under a millisecond; binning ([`super::draw`])
+//! then costs more than the second thread saves, as its set-up records go through
+//! memory between two parallel steps. Here there is one step: each thread scans the
+//! triangles in draw order, skips those whose box (known from the projected vertices
+//! alone) misses its strip, and sets up and walks the others with their boxes cut to
+//! its rows ([`Setup::rows`]), as one thread would. Only triangles crossing a strip's
+//! border are set up twice.
+//!
+//! The strips hold about as many vertices each (counted per 8 rows before the draw),
+//! so the threads finish together. The strips are worth it only to a caller that runs
+//! on the pool's threads itself (`Renderer::plan_frame`): handing a frame of a few
+//! hundred microseconds to a sleeping thread and waiting for it to be handed back
+//! costs more than the second thread saves.
+//!
+//! Every triangle is counted by one strip (its owner), so the counters are one
+//! thread's: the strip that holds the first row of its box (clamped to the target),
+//! or the first strip for a triangle that needs clipping or is rejected, which every
+//! strip sets up.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::{Job, TileCopy};
+use crate::raster::Setup;
+use crate::raster::depth::DepthRows;
+use crate::render::fragments::PieceWalker;
+use crate::render::isa::DrawVariant;
+use crate::render::options::{DrawOptions, DrawStats};
+use crate::render::prepare::{
+    EmitPiece, PrepareOutcome, Prepared, Projected, VertexCache, prepare_projected,
+    project_vertices,
+};
+use crate::render::shader::Shader;
+use crate::render::{ColorTarget, Renderer};
+use crate::simd::I32s;
+
+/// The most strips a draw is cut into: a larger pool leaves its other threads idle.
+pub const MAX_STRIPS: usize = 16;
+
+/// The longest the first strip's thread spins waiting for the others before it
+/// waits as rayon does (by sleeping once nothing is left to steal).
+const MAX_SPIN: Duration = Duration::from_millis(2);
+
+/// Hands each piece of a triangle to the walker with its box cut to the strip's
+/// rows.
+struct Cut<'w, W> {
+    walker: &'w mut W,
+    rows: [u32; 2],
+}
+
+impl<V, W: StripWalk<V>> EmitPiece<V> for Cut<'_, W> {
+    #[inline(always)]
+    fn piece(&mut self, p: &Prepared<V>) {
+        let b = p.setup.bbox;
+        let [y0, y1] = self.rows;
+        if b.y0 >= y0 && b.y1 <= y1 {
+            self.walker.walk_setup(p, &p.setup);
+        } else if let Some(s) = p.setup.rows(y0, y1) {
+            self.walker.walk_setup(p, &s);
+        }
+    }
+}
+
+/// [`PieceWalker::walk`], named so [`Cut`] needs no type parameters of its own.
+trait StripWalk<V> {
+    fn walk_setup(&mut self, p: &Prepared<V>, s: &Setup);
+}
+
+impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> StripWalk<S::Varying>
+    for PieceWalker<'_, S, C, L, V, DepthRows<'_>>
+{
+    #[inline(always)]
+    fn walk_setup(&mut self, p: &Prepared<S::Varying>, s: &Setup) {
+        self.walk(p, s);
+    }
+}
+
+/// Draws strip `strip` of those ending at rows `ends` (its rows of `color` and
+/// `depth`) of every triangle of the draw, first filling the colour rows with `clear`
+/// if given, with variant `V` on lanes `L`; returns the strip's counters. The body of
+/// every copy's [`TileCopy::strip`].
+#[inline(always)]
+pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
+    job: &Job<'_, S>,
+    ends: &[u32],
+    strip: usize,
+    color: &mut C,
+    depth: &mut DepthRows<'_>,
+    clear: Option<Vec3>,
+) -> DrawStats {
+    if let Some(background) = clear {
+        let len = color.len();
+        color.reset(len, background);
+    }
+    let y0 = if strip == 0 { 0 } else { ends[strip - 1] };
+    let y1 = ends[strip] - 1;
+    let last_row = i64::from(job.target.height) - 1;
+    let mut walker =
+        PieceWalker::<S, C, L, V, _>::new(job.shader, depth, color, &job.opts, job.target);
+    let mut stats = DrawStats::default();
+    let (indices, projected) = (job.indices, job.projected);
+    let n = (indices.len() / 3) as u32;
+    for t in 0..n {
+        let base = t as usize * 3;
+        let vertex = |k: usize| projected.get(indices[base + k] as usize).copied();
+        let (Some(a), Some(b), Some(c)) = (vertex(0), vertex(1), vertex(2)) else {
+            // A vertex out of range: rejected, counted by the first strip.
+            if strip == 0 {
+                stats.triangles += 1;
+                stats.rejected += 1;
+            }
+            continue;
+        };
+        let owner = match Projected::unclipped_rows([a, b, c]) {
+            Some([top, bottom]) => {
+                let first = top.clamp(0, last_row) as u32;
+                let owner = ends.iter().position(|&e| first < e).unwrap_or(0);
+                if owner != strip && (bottom < i64::from(y0) || top > i64::from(y1)) {
+                    continue;
+                }
+                owner
+            }
+            None => 0,
+        };
+        let mut cut = Cut {
+            walker: &mut walker,
+            rows: [y0, y1],
+        };
+        let (cache, target, cull) = (job.cache, job.target, job.opts.cull);
+        let outcome = prepare_projected(cache, Some(projected), indices, t, target, cull, &mut cut);
+        if owner == strip {
+            stats.triangles += 1;
+            match outcome {
+                PrepareOutcome::Rejected => stats.rejected += 1,
+                PrepareOutcome::Culled => stats.culled += 1,
+                PrepareOutcome::Drawn { clipped } => {
+                    stats.drawn += 1;
+                    stats.clipped += u64::from(clipped);
+                }
+            }
+        }
+    }
+    stats.fragments = walker.stats.fragments;
+    stats.shaded = walker.stats.shaded;
+    stats
+}
+
+/// Where `strips` strips of a target `height` rows high end, each a multiple of 8
+/// rows but the last, so that each holds about as many of the `projected` vertices
+/// (`hist` is scratch); strips left without rows are dropped. Returns the ends and
+/// how many strips there are.
+#[must_use]
+pub fn strip_ends(
+    projected: &[Projected],
+    height: u32,
+    strips: usize,
+    hist: &mut Vec<u32>,
+) -> ([u32; MAX_STRIPS], usize) {
+    let strips = strips.clamp(1, MAX_STRIPS);
+    let blocks = height.div_ceil(8) as usize;
+    hist.clear();
+    hist.resize(blocks, 0);
+    let last = i64::from(height.max(1)) - 1;
+    for p in projected {
+        if let Some(row) = p.row() {
+            hist[(row.clamp(0, last) / 8) as usize] += 1;
+        }
+    }
+    let total: u64 = hist.iter().map(|&c| u64::from(c)).sum();
+    let mut ends = [height; MAX_STRIPS];
+    let mut count = 0;
+    let mut seen = 0u64;
+    for (b, &c) in hist.iter().enumerate() {
+        // Without vertices, strips of equal height.
+        seen += if total == 0 { 1 } else { u64::from(c) };
+        let all = if total == 0 { blocks as u64 } else { total };
+        let end = ((b + 1) * 8).min(height as usize) as u32;
+        while count + 1 < strips && seen * strips as u64 >= all * (count as u64 + 1) {
+            if count == 0 || ends[count - 1] < end {
+                ends[count] = end;
+                count += 1;
+            } else {
+                break;
+            }
+        }
+    }
+    if count == 0 || ends[count - 1] < height {
+        ends[count] = height;
+        count += 1;
+    }
+    (ends, count)
+}
+
+/// Draws on the renderer's pool with copy `T`, a strip per thread: the small-frame
+/// form of `Renderer::draw_triangles`, with the same frame and counters.
+///
+/// # Safety
+/// The CPU must have `T`'s instruction set (as [`crate::render::DrawCopy::choose`]
+/// ensures).
+pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
+    r: &mut Renderer,
+    shader: &S,
+    cache: &VertexCache<S::Varying>,
+    indices: &[u32],
+    opts: &DrawOptions,
+    color: &mut C,
+) {
+    let Some(pool) = r.pool.clone() else {
+        unreachable!("a threaded draw without a pool");
+    };
+    let target = r.target;
+    let projected = match cache.projections(target) {
+        Some(pv) => pv,
+        None => {
+            project_vertices(cache, target, &mut r.projected);
+            &r.projected[..]
+        }
+    };
+    let (ends, count) = strip_ends(
+        projected,
+        target.height,
+        pool.current_num_threads(),
+        &mut r.scratch.rows,
+    );
+    let ends = &ends[..count];
+    let clear = r.pending_clear.take();
+    let job = Job {
+        shader,
+        cache,
+        projected,
+        indices,
+        opts: *opts,
+        target,
+        band_rows: 0,
+    };
+    let mut pixel_ends = [0; MAX_STRIPS];
+    for (p, &e) in pixel_ends.iter_mut().zip(ends) {
+        *p = e as usize * target.width as usize;
+    }
+    let mut parts: [Option<(C::Rows<'_>, DepthRows<'_>)>; MAX_STRIPS] = Default::default();
+    let mut colors = [const { None }; MAX_STRIPS];
+    let mut k = 0;
+    color.split_rows(&pixel_ends[..count], |c| {
+        colors[k] = Some(c);
+        k += 1;
+    });
+    let mut k = 0;
+    r.depth.split_rows(ends, |d| {
+        parts[k] = colors[k].take().map(|c| (c, d));
+        k += 1;
+    });
+    // Strips run by rayon's join: one that no thread has taken when the calling
+    // thread is done with its own (the others asleep) is drawn by the calling thread.
+    // One that another thread has started is waited for by spinning, briefly: put to
+    // sleep, the calling thread would wake later than the strip ends.
+    let (started, done) = (AtomicUsize::new(0), AtomicUsize::new(0));
+    let stats = pool.install(|| {
+        parts[..count]
+            .par_iter_mut()
+            .enumerate()
+            .with_max_len(1)
+            .map(|(i, part)| {
+                let Some((c, d)) = part.as_mut() else {
+                    return DrawStats::default();
+                };
+                if i > 0 {
+                    started.fetch_add(1, Ordering::AcqRel);
+                }
+                let start = Instant::now();
+                // SAFETY: the caller's guarantee.
+                let stats = unsafe { T::strip(&job, ends, i, c, d, clear) };
+                if i > 0 {
+                    done.fetch_add(1, Ordering::Release);
+                } else {
+                    let spin = start.elapsed().min(MAX_SPIN);
+                    let start = Instant::now();
+                    while done.load(Ordering::Acquire) < started.load(Ordering::Acquire)
+                        && start.elapsed() < spin
+                    {
+                        std::hint::spin_loop();
+                    }
+                }
+                stats
+            })
+            .reduce(DrawStats::default, |mut a, b| {
+                a += b;
+                a
+            })
+    });
+    r.stats += stats;
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec4;
+
+    use super::{MAX_STRIPS, strip_ends};
+    use crate::raster::Target;
+    use crate::raster::clip::guard_band_ndc;
+    use crate::render::Projected;
+
+    /// Each strip ends at the first 8-row block by which the strips so far hold their
+    /// share of the vertices; vertices off the target count at its nearest row, and
+    /// vertices that need clipping not at all.
+    #[test]
+    fn strips_hold_about_as_many_vertices_each() {
+        let target = Target::new(100, 240);
+        let guard = guard_band_ndc(target.width, target.height);
+        let at_row = |y: f32| {
+            let ndc = 1.0 - y / 240.0 * 2.0;
+            Projected::of(Vec4::new(0.1, ndc, 0.5, 1.0), target, guard)
+        };
+        // 10 vertices in rows 0-7, 10 above the target, 30 in rows 200-207, 20 in
+        // rows 232-239, and 50 behind the eye.
+        let mut pv: Vec<Projected> = Vec::new();
+        pv.extend((0..10).map(|i| at_row(0.5 + i as f32 * 0.7)));
+        pv.extend((0..10).map(|_| at_row(-20.0)));
+        pv.extend((0..30).map(|i| at_row(200.5 + i as f32 * 0.2)));
+        pv.extend((0..20).map(|_| at_row(239.5)));
+        let behind = Projected::of(Vec4::new(0.0, 0.0, 0.5, -1.0), target, guard);
+        pv.extend((0..50).map(|_| behind));
+        let mut hist = Vec::new();
+        // Halves: 20 of 70 by row 8, 50 by row 208.
+        assert_eq!(strip_ends(&pv, 240, 2, &mut hist).0[..2], [208, 240]);
+        // Quarters: 17.5 by row 8 (20), 35 by row 208, 52.5 by row 240.
+        let (ends, count) = strip_ends(&pv, 240, 4, &mut hist);
+        assert_eq!(&ends[..count], &[8, 208, 240]);
+        // Nothing to count: equal heights.
+        assert_eq!(
+            strip_ends(&[behind], 240, 3, &mut hist).0[..3],
+            [80, 160, 240]
+        );
+    }
+
+    /// Strips cover the target in order, end on multiples of 8 rows (but the last),
+    /// and are never empty, whatever the thread count and height.
+    #[test]
+    fn strips_cover_the_target_in_blocks_of_rows() {
+        for strips in 1..=MAX_STRIPS + 2 {
+            for height in 1..300 {
+                let (ends, count) = strip_ends(&[], height, strips, &mut Vec::new());
+                assert!((1..=strips.min(MAX_STRIPS)).contains(&count));
+                assert_eq!(ends[count - 1], height);
+                let mut y = 0;
+                for &e in &ends[..count] {
+                    assert!(e > y, "{height} {strips}: {ends:?}");
+                    assert!(e == height || e.is_multiple_of(8));
+                    y = e;
+                }
+            }
+        }
+    }
+}

@@ -53,7 +53,7 @@ pub mod probe;
 pub mod shader;
 pub mod shaders;
 pub mod target;
-pub mod tiles;
+mod tiles;
 pub mod wire;
 
 use std::sync::Arc;

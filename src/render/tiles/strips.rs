@@ -216,6 +216,11 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
         unreachable!("a threaded draw without a pool");
     };
     let target = r.target;
+    assert_eq!(
+        color.len(),
+        target.len(),
+        "the colour target is not the frame's size"
+    );
     let projected = match cache.projections(target) {
         Some(pv) => pv,
         None => {

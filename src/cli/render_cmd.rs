@@ -185,11 +185,19 @@ pub fn png(args: &PngArgs) -> Result<(), super::CliError> {
         frame,
         time: 0.0,
     };
-    text_frames(args, |vp, n| {
-        settings.angle = angle(n);
-        state.time = time(n);
-        vp.render(&mut state, &settings, (args.cols, args.rows));
-    })
+    let pool = state.frame.renderer.thread_pool().cloned();
+    let mut run = || {
+        text_frames(args, |vp, n| {
+            settings.angle = angle(n);
+            state.time = time(n);
+            vp.render(&mut state, &settings, (args.cols, args.rows));
+        })
+    };
+    // The frame loop on the drawing threads, as the viewer's (`Renderer::plan_frame`).
+    match pool {
+        Some(pool) => pool.install(run),
+        None => run(),
+    }
 }
 
 /// Seconds of scene time between text frames.

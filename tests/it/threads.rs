@@ -391,3 +391,29 @@ proptest! {
         }
     }
 }
+
+/// `termrast render`'s text frames, its loop on the pool (frames of the bunny at
+/// 200×60 cells are drawn in strips there), are the same bytes on 1, 2 and 3 threads.
+#[test]
+fn render_command_frames_are_the_same_on_every_thread_count() {
+    let frames = |threads: &str| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_termrast"))
+            .args([
+                "render", "bunny", "--frames", "3", "--cols", "200", "--rows", "60",
+            ])
+            .args(["--threads", threads])
+            .env("TERM", "xterm-256color")
+            .output()
+            .expect("the binary runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out.stdout
+    };
+    let one = frames("1");
+    assert!(one.len() > 10_000, "three frames of text");
+    assert!(one == frames("2"), "2 threads");
+    assert!(one == frames("3"), "3 threads");
+}

@@ -118,14 +118,8 @@ impl ColorTarget for Exact {
             .map(|(colors, writes)| ExactRows { colors, writes })
     }
 
-    fn split_rows<'s>(&'s mut self, ends: &[usize], mut f: impl FnMut(ExactRows<'s>)) {
-        let mut writes = Vec::new();
-        split_slice(&mut self.writes[..], ends, |w| writes.push(w));
-        let mut writes = writes.into_iter();
-        split_slice(&mut self.colors[..], ends, |colors| {
-            let writes = writes.next().expect("as many pieces as colours");
-            f(ExactRows { colors, writes });
-        });
+    fn split_rows<'s>(&'s mut self, ends: &[usize], f: impl FnMut(ExactRows<'s>)) {
+        split_exact(&mut self.colors, &mut self.writes, ends, f);
     }
 }
 
@@ -164,15 +158,26 @@ impl ColorTarget for ExactRows<'_> {
             .map(|(colors, writes)| ExactRows { colors, writes })
     }
 
-    fn split_rows<'s>(&'s mut self, ends: &[usize], mut f: impl FnMut(ExactRows<'s>)) {
-        let mut writes = Vec::new();
-        split_slice(&mut self.writes[..], ends, |w| writes.push(w));
-        let mut writes = writes.into_iter();
-        split_slice(&mut self.colors[..], ends, |colors| {
-            let writes = writes.next().expect("as many pieces as colours");
-            f(ExactRows { colors, writes });
-        });
+    fn split_rows<'s>(&'s mut self, ends: &[usize], f: impl FnMut(ExactRows<'s>)) {
+        split_exact(self.colors, self.writes, ends, f);
     }
+}
+
+/// [`ColorTarget::split_rows`] of an [`Exact`] target or band: its colours and write
+/// counts cut at the same pixels.
+fn split_exact<'s>(
+    colors: &'s mut [Option<Vec3>],
+    writes: &'s mut [u32],
+    ends: &[usize],
+    mut f: impl FnMut(ExactRows<'s>),
+) {
+    let mut pieces = Vec::new();
+    split_slice(writes, ends, |w| pieces.push(w));
+    let mut pieces = pieces.into_iter();
+    split_slice(colors, ends, |colors| {
+        let writes = pieces.next().expect("as many pieces as colours");
+        f(ExactRows { colors, writes });
+    });
 }
 
 /// Clip-space vertices given directly, with a Vec3 attribute each.

@@ -103,6 +103,9 @@ pub struct Renderer {
     /// ([`Spread::Strips`]), if the caller runs on the pool ([`Renderer::plan_frame`]);
     /// below it, the draw is too short for the threads to meet in time. Tests set 0.
     pub min_strip_work: u64,
+    /// The fewest vertices whose vertex stage ([`Renderer::transform`]) runs on the
+    /// frame's threads; [`MIN_PARALLEL_VERTICES`] by default. Tests set 0.
+    pub min_parallel_vertices: usize,
     /// How the current draw is shared among threads.
     spread: Spread,
     /// Whether this frame may use the pool at all ([`Renderer::plan_frame`]).
@@ -116,6 +119,11 @@ pub struct Renderer {
 /// the draw projects them, in its own copy of the loop (AVX2 or AVX-512), which is
 /// faster than the vertex stage's.
 pub const FUSED_PROJECTION_VERTICES: usize = 1 << 16;
+
+/// The default [`Renderer::min_parallel_vertices`]: a smaller mesh's vertex stage (the
+/// bunny's 1 839 vertices take a few microseconds) is done sooner by the calling thread
+/// than handed to a sleeping one and waited for; the draw then projects them.
+pub const MIN_PARALLEL_VERTICES: usize = 1 << 12;
 
 /// Pixels a triangle's share of a draw is worth, for [`Renderer::min_threaded_work`]:
 /// set-up and binning, which many small triangles make the larger part.
@@ -156,6 +164,7 @@ impl Renderer {
             pending_clear: None,
             min_threaded_work: MIN_THREADED_WORK,
             min_strip_work: MIN_STRIP_WORK,
+            min_parallel_vertices: MIN_PARALLEL_VERTICES,
             spread: Spread::One,
             frame_threads: true,
             frame_bins: true,
@@ -221,7 +230,8 @@ impl Renderer {
 
     /// [`transform_projected`] for the renderer's target, on its threads (the same
     /// vertices, in chunks of the vertex array): the draws that follow use the
-    /// projections instead of making their own. On one thread, a mesh of fewer than
+    /// projections instead of making their own. On one thread (or for fewer than
+    /// [`Renderer::min_parallel_vertices`]), a mesh of fewer than
     /// [`FUSED_PROJECTION_VERTICES`] is only transformed.
     pub fn transform<S: Shader>(
         &self,
@@ -230,7 +240,10 @@ impl Renderer {
         cache: &mut VertexCache<S::Varying>,
     ) {
         let target = self.target;
-        let Some(pool) = self.pool() else {
+        let pool = self
+            .pool()
+            .filter(|_| vertex_count >= self.min_parallel_vertices);
+        let Some(pool) = pool else {
             if vertex_count >= FUSED_PROJECTION_VERTICES {
                 transform_projected(shader, vertex_count, cache, target);
             } else {

@@ -27,8 +27,10 @@ type Bits = (Vec<[u8; 4]>, Vec<u32>, DrawStats);
 /// The ways draws are shared among threads.
 const WAYS: [Spread; 2] = [Spread::Bins, Spread::Strips];
 
-/// Sets the thresholds so that every draw of `r` with threads is shared `way`.
-fn share(r: &mut Renderer, way: Spread) {
+/// Sets the thresholds so that every draw of `r` with threads is shared `way`, its
+/// vertex stage on the threads too (`parallel_vertices`) or on the calling thread
+/// (the draw then projects the vertices itself).
+fn share(r: &mut Renderer, way: Spread, parallel_vertices: bool) {
     match way {
         Spread::Bins => r.min_threaded_work = 0,
         _ => {
@@ -36,6 +38,7 @@ fn share(r: &mut Renderer, way: Spread) {
             r.min_strip_work = 0;
         }
     }
+    r.min_parallel_vertices = if parallel_vertices { 0 } else { usize::MAX };
 }
 
 /// One frame of `scene` drawn on `threads` threads, shared `way`; the frame runs on
@@ -51,7 +54,7 @@ fn frame_bits(
     let mut frame = SceneFrame::new(scene);
     frame.renderer.isa = isa;
     frame.renderer.set_threads(threads);
-    share(&mut frame.renderer, way);
+    share(&mut frame.renderer, way, true);
     assert_eq!(frame.renderer.threads(), threads);
     frame.interpolation = interpolation;
     frame.traversal = traversal;
@@ -209,7 +212,7 @@ fn probe_equals_the_threaded_framebuffer() {
         scene.set_cull(cull);
         let mut frame = SceneFrame::new(&scene);
         frame.renderer.set_threads(2);
-        share(&mut frame.renderer, way);
+        share(&mut frame.renderer, way, true);
         let pool = frame.renderer.thread_pool().cloned().expect("two threads");
         pool.install(|| frame.draw(&scene, target, &turned(angle)));
         assert_eq!(frame.renderer.spread(), way);
@@ -238,7 +241,9 @@ fn probe_equals_the_threaded_framebuffer() {
 type Drawn = (Vec<Option<Vec3>>, Vec<u32>, Vec<u32>, DrawStats);
 
 /// Draws `shader`'s triangles on `threads` threads, shared `way`, into an [`Exact`]
-/// target, which fails the test on a write outside the band or strip being drawn.
+/// target, which fails the test on a write outside the band or strip being drawn. The
+/// vertex stage runs on the calling thread, so the draw projects the vertices (the
+/// scene frames of [`frame_bits`] project them on the threads).
 fn draw_direct(
     shader: &Direct,
     indices: &[u32],
@@ -248,7 +253,7 @@ fn draw_direct(
 ) -> Drawn {
     let mut r = Renderer::new(target);
     r.set_threads(threads);
-    share(&mut r, way);
+    share(&mut r, way, false);
     let mut out = Exact::default();
     let mut cache = VertexCache::default();
     r.begin_frame(target, &mut out, Vec3::ZERO);

@@ -5,8 +5,8 @@
 //!
 //! 1. **Vertices**: every vertex goes through the vertex stage and is projected once
 //!    ([`Projected::of`]), in parallel chunks of the vertex array, in one pass
-//!    ([`super::Renderer::transform`]; a draw whose vertices were transformed alone
-//!    projects them here, the same way).
+//!    ([`super::Renderer::transform`]; a draw whose vertices were transformed alone,
+//!    those of a small mesh, projects them here, the same way: `vertices`).
 //! 2. **Set-up and binning**: the triangles are cut into chunks of consecutive
 //!    triangles; each chunk's thread clips and sets up its triangles once
 //!    ([`prepare_projected`], as on one thread) into the chunk's records, in draw order,
@@ -45,14 +45,15 @@ use super::prepare::{
 use super::shader::Shader;
 use super::target::ColorTarget;
 use super::{Renderer, Spread};
-use crate::raster::clip::guard_band_ndc;
 use crate::raster::depth::DepthRows;
 use crate::raster::{Setup, Target};
 use crate::simd::I32s;
 use queue::plan_bands;
+pub(super) use vertices::project_claimed;
 
 mod queue;
 pub mod strips;
+mod vertices;
 
 /// The tallest band: a multiple of the block traversal's 8 and of the depth clear
 /// tile. Chosen by measurement (see `docs/performance.md`).
@@ -282,15 +283,7 @@ unsafe fn draw_binned<T: TileCopy, S: Shader, C: ColorTarget>(
         let projected = match cache.projections(target) {
             Some(pv) => pv,
             None => {
-                let guard = guard_band_ndc(target.width, target.height);
-                projected.clear();
-                projected.par_extend(
-                    cache
-                        .verts
-                        .par_iter()
-                        .with_min_len(VERTEX_JOB)
-                        .map(|v| Projected::of(v.pos, target, guard)),
-                );
+                project_claimed(cache, target, projected);
                 &projected[..]
             }
         };

@@ -27,7 +27,7 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{Job, TileCopy};
+use super::{Job, TileCopy, project_claimed};
 use crate::raster::Setup;
 use crate::raster::depth::DepthRows;
 use crate::render::fragments::PieceWalker;
@@ -35,7 +35,6 @@ use crate::render::isa::DrawVariant;
 use crate::render::options::{DrawOptions, DrawStats};
 use crate::render::prepare::{
     EmitPiece, PrepareOutcome, Prepared, Projected, VertexCache, prepare_projected,
-    project_vertices,
 };
 use crate::render::shader::Shader;
 use crate::render::{ColorTarget, Renderer};
@@ -224,7 +223,7 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
     let projected = match cache.projections(target) {
         Some(pv) => pv,
         None => {
-            project_vertices(cache, target, &mut r.projected);
+            project_claimed(cache, target, &mut r.projected);
             &r.projected[..]
         }
     };

@@ -1,0 +1,108 @@
+//! The projections of a threaded draw whose vertices were transformed on the calling
+//! thread alone (a mesh under `Renderer::min_parallel_vertices`).
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, PoisonError};
+
+use super::VERTEX_JOB;
+use crate::raster::Target;
+use crate::raster::clip::guard_band_ndc;
+use crate::render::prepare::{Projected, VertexCache};
+
+/// The most pieces [`project_claimed`] cuts the vertices into.
+const PIECES: usize = 64;
+
+/// Projects every vertex of `cache` for `target` into `out` (as
+/// [`crate::render::project_vertices`] does), the calling thread and one other of the
+/// current pool taking pieces of at least [`VERTEX_JOB`] vertices until none is left.
+///
+/// Claimed rather than split in halves: the other thread, often woken from sleep by
+/// the call, takes only what is left when it arrives, so the calling thread waits at
+/// most for the piece in its hands (rayon's split made it wait for a stolen half);
+/// and the other thread is then awake for the draw's next step.
+pub(in crate::render) fn project_claimed<V: Sync>(
+    cache: &VertexCache<V>,
+    target: Target,
+    out: &mut Vec<Projected>,
+) {
+    let guard = guard_band_ndc(target.width, target.height);
+    let verts = &cache.verts[..];
+    out.clear();
+    if verts.is_empty() {
+        return;
+    }
+    // Every slot is overwritten below.
+    out.resize(verts.len(), Projected::default());
+    let piece = VERTEX_JOB.max(verts.len().div_ceil(PIECES));
+    let slots: [Mutex<Option<&mut [Projected]>>; PIECES] =
+        std::array::from_fn(|_| Mutex::new(None));
+    for (slot, p) in slots.iter().zip(out.chunks_mut(piece)) {
+        *lock(slot) = Some(p);
+    }
+    let next = AtomicUsize::new(0);
+    let work = || {
+        loop {
+            let k = next.fetch_add(1, Ordering::Relaxed);
+            let Some(dst) = slots.get(k).and_then(|s| lock(s).take()) else {
+                return;
+            };
+            for (d, v) in dst.iter_mut().zip(&verts[k * piece..]) {
+                *d = Projected::of(v.pos, target, guard);
+            }
+        }
+    };
+    rayon::join(work, work);
+}
+
+/// A lock that a panic elsewhere does not poison for good.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec4;
+
+    use super::project_claimed;
+    use crate::raster::Target;
+    use crate::raster::clip::ClipVertex;
+    use crate::render::prepare::VertexCache;
+    use crate::render::{Projected, project_vertices};
+
+    /// Every vertex gets the projection one thread gives it, for meshes of no vertex,
+    /// fewer than a piece, and pieces that do not divide the count, from a pool of
+    /// two threads and from outside any pool.
+    #[test]
+    fn claimed_projections_equal_one_threads() {
+        let target = Target::new(37, 23);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a pool");
+        for n in [0, 1, 5, 511, 512, 513, 4099, 40_000] {
+            let verts = (0..n)
+                .map(|i| {
+                    let t = i as f32 * 0.37;
+                    let w = 0.2 + (t * 0.11).sin().abs() * 3.0;
+                    ClipVertex {
+                        pos: Vec4::new(t.sin() * 1.3 * w, t.cos() * 1.2 * w, 0.5 * w, w),
+                        var: (),
+                    }
+                })
+                .collect();
+            let cache = VertexCache::<()> {
+                verts,
+                ..VertexCache::default()
+            };
+            let mut one = Vec::new();
+            project_vertices(&cache, target, &mut one);
+            // Debug prints each float exactly: equal text, equal bits.
+            let one = format!("{one:?}");
+            let mut shared = vec![Projected::default(); 3];
+            pool.install(|| project_claimed(&cache, target, &mut shared));
+            assert_eq!(format!("{shared:?}"), one, "{n} vertices on the pool");
+            project_claimed(&cache, target, &mut shared);
+            assert_eq!(format!("{shared:?}"), one, "{n} vertices off any pool");
+        }
+    }
+}

@@ -119,7 +119,7 @@ where
 
 /// A lock that a panic elsewhere does not poison for good (the panic propagates
 /// through the join anyway).
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+pub(super) fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(PoisonError::into_inner)
 }
 

@@ -223,7 +223,8 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
     let projected = match cache.projections(target) {
         Some(pv) => pv,
         None => {
-            project_claimed(cache, target, &mut r.projected);
+            let out = &mut r.projected;
+            pool.install(|| project_claimed(cache, target, out));
             &r.projected[..]
         }
     };

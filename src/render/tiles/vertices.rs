@@ -1,10 +1,11 @@
 //! The projections of a threaded draw whose vertices were transformed on the calling
 //! thread alone (a mesh under `Renderer::min_parallel_vertices`).
 
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, PoisonError};
 
 use super::VERTEX_JOB;
+use super::queue::lock;
 use crate::raster::Target;
 use crate::raster::clip::guard_band_ndc;
 use crate::render::prepare::{Projected, VertexCache};
@@ -52,11 +53,6 @@ pub(in crate::render) fn project_claimed<V: Sync>(
         }
     };
     rayon::join(work, work);
-}
-
-/// A lock that a panic elsewhere does not poison for good.
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 #[cfg(test)]

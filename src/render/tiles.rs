@@ -67,9 +67,10 @@ const CHUNK_TRIANGLES: usize = 4096;
 /// finishes early takes another.
 const CHUNKS_PER_THREAD: usize = 4;
 
-/// Vertices per parallel job of the vertex steps: small enough that a model of a few
-/// thousand vertices is shared out, which wakes the pool before the set-up needs it
-/// (smaller jobs cost more to hand out than they save).
+/// Vertices per parallel job of the vertex stage, and per claimed piece of a small
+/// mesh's projections (`vertices`): small enough that a mesh of a few thousand
+/// vertices is shared out, which wakes the pool before the set-up needs it (smaller
+/// jobs cost more to hand out than they save).
 pub(super) const VERTEX_JOB: usize = 512;
 
 /// What a piece costs the walk of a band besides its pixels, in pixels (the walk's

@@ -49,7 +49,7 @@ use crate::raster::depth::DepthRows;
 use crate::raster::{Setup, Target};
 use crate::simd::I32s;
 use queue::plan_bands;
-pub(super) use vertices::project_claimed;
+use vertices::projections;
 
 mod queue;
 pub mod strips;
@@ -281,13 +281,7 @@ unsafe fn draw_binned<T: TileCopy, S: Shader, C: ColorTarget>(
     let depth = &mut r.depth;
     let mut clear = r.pending_clear.take();
     let stats = pool.install(|| {
-        let projected = match cache.projections(target) {
-            Some(pv) => pv,
-            None => {
-                project_claimed(cache, target, projected);
-                &projected[..]
-            }
-        };
+        let projected = projections(cache, target, projected);
         let job = Job {
             shader,
             cache,

@@ -27,7 +27,7 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{Job, TileCopy, project_claimed};
+use super::{Job, TileCopy, projections};
 use crate::raster::Setup;
 use crate::raster::depth::DepthRows;
 use crate::render::fragments::PieceWalker;
@@ -220,14 +220,8 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
         target.len(),
         "the colour target is not the frame's size"
     );
-    let projected = match cache.projections(target) {
-        Some(pv) => pv,
-        None => {
-            let out = &mut r.projected;
-            pool.install(|| project_claimed(cache, target, out));
-            &r.projected[..]
-        }
-    };
+    let store = &mut r.projected;
+    let projected = pool.install(|| projections(cache, target, store));
     let (ends, count) = strip_ends(
         projected,
         target.height,

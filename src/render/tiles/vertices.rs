@@ -13,6 +13,23 @@ use crate::render::prepare::{Projected, VertexCache};
 /// The most pieces [`project_claimed`] cuts the vertices into.
 const PIECES: usize = 64;
 
+/// The projections of `cache`'s vertices for `target`: those its vertex stage made,
+/// or else made now into `store` by [`project_claimed`]. What every threaded draw
+/// walks from.
+pub(in crate::render) fn projections<'a, V: Sync>(
+    cache: &'a VertexCache<V>,
+    target: Target,
+    store: &'a mut Vec<Projected>,
+) -> &'a [Projected] {
+    match cache.projections(target) {
+        Some(pv) => pv,
+        None => {
+            project_claimed(cache, target, store);
+            store
+        }
+    }
+}
+
 /// Projects every vertex of `cache` for `target` into `out` (as
 /// [`crate::render::project_vertices`] does), the calling thread and one other of the
 /// current pool taking pieces of at least [`VERTEX_JOB`] vertices until none is left.
@@ -21,11 +38,7 @@ const PIECES: usize = 64;
 /// the call, takes only what is left when it arrives, so the calling thread waits at
 /// most for the piece in its hands (rayon's split made it wait for a stolen half);
 /// and the other thread is then awake for the draw's next step.
-pub(in crate::render) fn project_claimed<V: Sync>(
-    cache: &VertexCache<V>,
-    target: Target,
-    out: &mut Vec<Projected>,
-) {
+fn project_claimed<V: Sync>(cache: &VertexCache<V>, target: Target, out: &mut Vec<Projected>) {
     let guard = guard_band_ndc(target.width, target.height);
     let verts = &cache.verts[..];
     out.clear();

@@ -47,7 +47,7 @@ use super::target::ColorTarget;
 use super::{Renderer, Spread};
 use crate::raster::depth::DepthRows;
 use crate::raster::{Setup, Target};
-use crate::simd::I32s;
+use crate::simd::{I32s, prefetch};
 use queue::plan_bands;
 use vertices::projections;
 
@@ -491,7 +491,12 @@ pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
     let mut walker =
         PieceWalker::<S, C, L, V, _>::new(job.shader, depth, color, &job.opts, job.target);
     for chunk in chunks {
-        for &i in chunk.bin(band) {
+        let bin = chunk.bin(band);
+        for (k, &i) in bin.iter().enumerate() {
+            // The next record is on its way while this one is walked (see `prefetch`).
+            if let Some(&next) = bin.get(k + 1) {
+                prefetch(&chunk.records[next as usize]);
+            }
             let tri = &chunk.records[i as usize];
             let b = tri.setup.bbox;
             let cut: Setup;

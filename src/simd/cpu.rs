@@ -75,3 +75,23 @@ impl Isa {
         }
     }
 }
+
+/// Asks the CPU to bring every cache line of `value` towards this core, without
+/// waiting for it: a hint that changes no result. A threaded walk reads each set-up
+/// record (several lines, written by another core) only once, so it asks for the next
+/// record while it walks the current one.
+#[inline(always)]
+pub fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let start = std::ptr::from_ref(value).cast::<i8>();
+        for offset in (0..size_of::<T>()).step_by(64) {
+            // SAFETY: SSE is part of x86-64, and a prefetch never faults; the address
+            // lies within `value` anyway.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}

@@ -191,7 +191,7 @@ macro_rules! binop {
 mod cpu;
 mod portable;
 
-pub use cpu::Isa;
+pub use cpu::{Isa, prefetch};
 
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx2;

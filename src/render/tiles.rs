@@ -59,9 +59,12 @@ mod vertices;
 /// tile. Chosen by measurement (see `docs/performance.md`).
 pub const BAND_ROWS: u32 = 48;
 
-/// Triangles per chunk of a batch (see [`draw`]): a batch's records stay a few
-/// megabytes however large the mesh.
-const CHUNK_TRIANGLES: usize = 4096;
+/// Triangles per chunk of a batch (see [`draw`]): a batch's records stay bounded
+/// however large the mesh (some 28 MB at most on two threads, when every triangle
+/// leaves one), while a mesh of up to 65 536 triangles on two threads is one batch.
+/// Each batch costs a hand-over between set-up and walk; chosen by measurement (see
+/// `docs/performance.md`).
+const CHUNK_TRIANGLES: usize = 8192;
 
 /// Chunks of triangles per thread in the set-up step: enough that a thread that
 /// finishes early takes another.

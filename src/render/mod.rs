@@ -75,7 +75,7 @@ pub use prepare::{
 pub use shader::{ShadeLanes, Shader};
 pub use target::{ColorTarget, Rgba8, Rgba8Rows};
 pub use tiles::strips::{MAX_STRIPS, strip_ends};
-pub use tiles::{BAND_ROWS, band_rows};
+pub use tiles::{BAND_ROWS, DENSE_BAND_ROWS, band_rows};
 
 /// Owns the depth buffer and frame counters; draws meshes into a colour target.
 #[derive(Debug)]
@@ -322,7 +322,7 @@ impl Renderer {
             return;
         };
         use rayon::prelude::*;
-        let rows = tiles::band_rows(self.target.height, pool.current_num_threads());
+        let rows = tiles::band_rows(self.target, pool.current_num_threads(), 0);
         let band = rows as usize * self.target.width as usize;
         pool.install(|| {
             color.bands(band).for_each(|mut b| {

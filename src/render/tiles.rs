@@ -59,6 +59,9 @@ mod vertices;
 /// tile. Chosen by measurement (see `docs/performance.md`).
 pub const BAND_ROWS: u32 = 48;
 
+/// The tallest band of a dense draw (see [`band_rows`]).
+pub const DENSE_BAND_ROWS: u32 = 96;
+
 /// Triangles per chunk of a batch (see [`draw`]): a batch's records stay bounded
 /// however large the mesh (some 28 MB at most on two threads, when every triangle
 /// leaves one), while a mesh of up to 65 536 triangles on two threads is one batch.
@@ -275,9 +278,9 @@ unsafe fn draw_binned<T: TileCopy, S: Shader, C: ColorTarget>(
     };
     let target = r.target;
     let threads = pool.current_num_threads();
-    let band_rows = band_rows(target.height, threads);
-    let bands = target.height.div_ceil(band_rows) as usize;
     let triangles = indices.len() / 3;
+    let band_rows = band_rows(target, threads, triangles);
+    let bands = target.height.div_ceil(band_rows) as usize;
     let n = (threads * CHUNKS_PER_THREAD).clamp(1, triangles.max(1));
     let (chunks, order, cost) = r.scratch.chunks::<S::Varying>(n, bands);
     let projected = &mut r.projected;
@@ -347,15 +350,27 @@ unsafe fn draw_binned<T: TileCopy, S: Shader, C: ColorTarget>(
     r.stats += stats;
 }
 
-/// Rows per band for a target `height` drawn on `threads` threads: about six bands
-/// per thread, so that the costliest-first hand-out can even the threads out, but at
-/// most [`BAND_ROWS`] (taller bands leave too few to share; shorter ones make more
-/// triangles cross a border and be walked twice). A multiple of 8 (the block walk's
-/// blocks and two depth clear tiles).
+/// Rows per band for `triangles` drawn into `target` on `threads` threads: about six
+/// bands per thread, so that the costliest-first hand-out can even the threads out,
+/// but at most [`BAND_ROWS`] (taller bands leave too few to share; shorter ones make
+/// more triangles cross a border and be walked twice). A dense draw, whose triangles
+/// would take 4 to 256 pixels each if they tiled the target, gets about four bands per
+/// thread of at most [`DENSE_BAND_ROWS`]: its many boxes of a few rows would cross
+/// short bands by the thousand, each crossing a second walk set-up, while its work is
+/// spread evenly enough to share out in fewer bands. (Smaller triangles have boxes of a
+/// row or two, which rarely cross.) A multiple of 8 (the block walk's blocks and two
+/// depth clear tiles).
 #[must_use]
-pub fn band_rows(height: u32, threads: usize) -> u32 {
-    let per = height / (6 * threads.max(1) as u32);
-    (per / 8 * 8).clamp(8, BAND_ROWS)
+pub fn band_rows(target: Target, threads: usize, triangles: usize) -> u32 {
+    let pixels = target.len();
+    let dense = (pixels / 256..=pixels / 4).contains(&triangles) && triangles > 0;
+    let (per_thread, tallest) = if dense {
+        (4, DENSE_BAND_ROWS)
+    } else {
+        (6, BAND_ROWS)
+    };
+    let per = target.height / (per_thread * threads.max(1) as u32);
+    (per / 8 * 8).clamp(8, tallest)
 }
 
 /// Files each piece into its chunk and counts it in the bins of the bands its box
@@ -522,7 +537,8 @@ pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
 
 #[cfg(test)]
 mod tests {
-    use super::{BAND_ROWS, Chunk, band_rows, fill_bins};
+    use super::{BAND_ROWS, Chunk, DENSE_BAND_ROWS, band_rows, fill_bins};
+    use crate::raster::Target;
 
     /// Each band's bin holds exactly the records whose span covers it, in draw order.
     #[test]
@@ -548,23 +564,36 @@ mod tests {
     }
 
     /// Bands are whole blocks of 8 rows, at most `BAND_ROWS`, and about six per
-    /// thread wherever the target is tall enough for that.
+    /// thread wherever the target is tall enough for that; a dense draw's at most
+    /// `DENSE_BAND_ROWS`, about four per thread.
     #[test]
     fn bands_are_blocks_of_rows_about_six_per_thread() {
         for threads in 1..=8 {
             for height in 1..2000 {
-                let rows = band_rows(height, threads);
-                assert!(rows.is_multiple_of(8) && (8..=BAND_ROWS).contains(&rows));
-                let bands = height.div_ceil(rows) as usize;
-                if rows < BAND_ROWS && rows > 8 {
-                    assert!(
-                        (6 * threads..12 * threads).contains(&bands),
-                        "{height} {threads}"
-                    );
+                let target = Target::new(100, height);
+                let dense = target.len() / 16;
+                for (triangles, per, tallest) in [
+                    (0, 6, BAND_ROWS),
+                    (20 * target.len(), 6, BAND_ROWS),
+                    (dense, 4, DENSE_BAND_ROWS),
+                ] {
+                    let rows = band_rows(target, threads, triangles);
+                    assert!(rows.is_multiple_of(8) && (8..=tallest).contains(&rows));
+                    let bands = height.div_ceil(rows) as usize;
+                    if rows < tallest && rows > 8 {
+                        assert!(
+                            (per * threads..2 * per * threads).contains(&bands),
+                            "{height} {threads} {triangles}"
+                        );
+                    }
                 }
             }
         }
-        assert_eq!(band_rows(240, 2), 16);
-        assert_eq!(band_rows(1080, 2), BAND_ROWS);
+        let hd = Target::new(1920, 1080);
+        assert_eq!(band_rows(Target::new(400, 240), 2, 200), 16);
+        assert_eq!(band_rows(hd, 2, 3674), BAND_ROWS);
+        assert_eq!(band_rows(hd, 2, 65_024), DENSE_BAND_ROWS);
+        assert_eq!(band_rows(hd, 2, 1 << 20), BAND_ROWS);
+        assert_eq!(band_rows(Target::new(400, 240), 2, 16_000), 24);
     }
 }

@@ -18,7 +18,9 @@
 //!    edge values at every pixel), so every pixel gets the same fragments, in the same
 //!    order, through the same copy of the draw loop ([`super::DrawCopy::choose`]).
 //!    Which thread walks which band, and when, is up to `queue`: costliest first
-//!    within each thread's run of bands, so that the threads finish together.
+//!    within each thread's run of bands, so that the threads finish together. The
+//!    records were written by whichever core set them up, so the walk asks for the
+//!    next one's cache lines while it walks the current one.
 //!
 //! The tiles are bands of whole rows ([`band_rows`] high) rather than squares: a band
 //! is one contiguous slice of the colour target and one of the depth buffer (and its

@@ -253,12 +253,36 @@ impl Renderer {
         };
         pool.install(|| {
             use rayon::prelude::*;
-            let guard = crate::raster::clip::guard_band_ndc(target.width, target.height);
-            (0..vertex_count as u32)
-                .into_par_iter()
-                .with_min_len(tiles::VERTEX_JOB)
-                .map(|i| prepare::project_vertex(shader, i, target, guard))
-                .unzip_into_vecs(&mut cache.verts, &mut cache.projected);
+            // A steady frame transforms into the vertices of the last and projects each
+            // piece while it is in the cache; a new vertex count makes room first.
+            let fresh = cache.verts.len() != vertex_count;
+            let vertex = |i: usize| {
+                let (pos, var) = shader.vertex(i as u32);
+                crate::raster::clip::ClipVertex { pos, var }
+            };
+            if fresh {
+                cache.verts.clear();
+                cache.verts.par_extend(
+                    (0..vertex_count)
+                        .into_par_iter()
+                        .with_min_len(tiles::VERTEX_JOB)
+                        .map(vertex),
+                );
+            }
+            let projected = prepare::slots(&mut cache.projected, vertex_count);
+            cache
+                .verts
+                .par_chunks_mut(tiles::VERTEX_JOB)
+                .zip(projected.par_chunks_mut(tiles::VERTEX_JOB))
+                .enumerate()
+                .for_each(|(k, (verts, out))| {
+                    if !fresh {
+                        for (j, v) in verts.iter_mut().enumerate() {
+                            *v = vertex(k * tiles::VERTEX_JOB + j);
+                        }
+                    }
+                    prepare::project_into(verts, target, out);
+                });
             cache.projected_for = Some(target);
         });
     }

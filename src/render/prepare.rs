@@ -17,6 +17,9 @@ use crate::raster::setup::{box_holds, box_rows, snap};
 use crate::raster::{SUBPIXEL_BITS, Setup, Target};
 use crate::simd::each3;
 
+mod lanes;
+pub(crate) use lanes::{project_into, slots};
+
 /// A triangle after clipping and projection, ready to rasterize. Vertex arrays are in
 /// setup order (A, B, C after any winding flip).
 #[derive(Clone, Copy, Debug)]
@@ -111,29 +114,22 @@ pub fn transform_projected<S: Shader>(
     cache: &mut VertexCache<S::Varying>,
     target: Target,
 ) {
-    let guard = guard_band_ndc(target.width, target.height);
     cache.verts.clear();
-    cache.projected.clear();
     cache.verts.reserve(vertex_count);
-    cache.projected.reserve(vertex_count);
-    for i in 0..vertex_count as u32 {
-        let (v, p) = project_vertex(shader, i, target, guard);
-        cache.verts.push(v);
-        cache.projected.push(p);
+    // Blocks small enough that their vertices are still in the L1 cache when projected.
+    const BLOCK: usize = 64;
+    for (b, out) in slots(&mut cache.projected, vertex_count)
+        .chunks_mut(BLOCK)
+        .enumerate()
+    {
+        let first = b * BLOCK;
+        cache.verts.extend((first..first + out.len()).map(|i| {
+            let (pos, var) = shader.vertex(i as u32);
+            ClipVertex { pos, var }
+        }));
+        project_into(&cache.verts[first..], target, out);
     }
     cache.projected_for = Some(target);
-}
-
-/// Vertex `i` through the vertex stage, and its projection.
-#[inline(always)]
-pub(crate) fn project_vertex<S: Shader>(
-    shader: &S,
-    i: u32,
-    target: Target,
-    guard: [f32; 2],
-) -> (ClipVertex<S::Varying>, Projected) {
-    let (pos, var) = shader.vertex(i);
-    (ClipVertex { pos, var }, Projected::of(pos, target, guard))
 }
 
 /// Receives the pieces [`prepare`] makes of a triangle. A trait rather than a closure
@@ -241,14 +237,7 @@ where
 
 /// Projects every vertex of `cache` for `target` into `out` (reusing its storage).
 pub fn project_vertices<V>(cache: &VertexCache<V>, target: Target, out: &mut Vec<Projected>) {
-    let guard = guard_band_ndc(target.width, target.height);
-    out.clear();
-    out.extend(
-        cache
-            .verts
-            .iter()
-            .map(|v| Projected::of(v.pos, target, guard)),
-    );
+    project_into(&cache.verts, target, slots(out, cache.verts.len()));
 }
 
 /// Clips, projects and sets up mesh triangle `t`, calling `emit` for each piece that

@@ -7,8 +7,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use super::VERTEX_JOB;
 use super::queue::lock;
 use crate::raster::Target;
-use crate::raster::clip::guard_band_ndc;
-use crate::render::prepare::{Projected, VertexCache};
+use crate::render::prepare::{Projected, VertexCache, project_into, slots};
 
 /// The most pieces [`project_claimed`] cuts the vertices into.
 const PIECES: usize = 64;
@@ -39,14 +38,12 @@ pub(in crate::render) fn projections<'a, V: Sync>(
 /// most for the piece in its hands (rayon's split made it wait for a stolen half);
 /// and the other thread is then awake for the draw's next step.
 fn project_claimed<V: Sync>(cache: &VertexCache<V>, target: Target, out: &mut Vec<Projected>) {
-    let guard = guard_band_ndc(target.width, target.height);
     let verts = &cache.verts[..];
-    out.clear();
     if verts.is_empty() {
+        out.clear();
         return;
     }
-    // Every slot is overwritten below.
-    out.resize(verts.len(), Projected::default());
+    let out = slots(out, verts.len());
     let piece = VERTEX_JOB.max(verts.len().div_ceil(PIECES));
     let slots: [Mutex<Option<&mut [Projected]>>; PIECES] =
         std::array::from_fn(|_| Mutex::new(None));
@@ -60,9 +57,8 @@ fn project_claimed<V: Sync>(cache: &VertexCache<V>, target: Target, out: &mut Ve
             let Some(dst) = slots.get(k).and_then(|s| lock(s).take()) else {
                 return;
             };
-            for (d, v) in dst.iter_mut().zip(&verts[k * piece..]) {
-                *d = Projected::of(v.pos, target, guard);
-            }
+            let first = k * piece;
+            project_into(&verts[first..first + dst.len()], target, dst);
         }
     };
     rayon::join(work, work);
@@ -77,6 +73,48 @@ mod tests {
     use crate::raster::clip::ClipVertex;
     use crate::render::prepare::VertexCache;
     use crate::render::{Projected, project_vertices};
+
+    /// The vertex stage on two threads (`Renderer::transform`), on a first frame and
+    /// on later ones that reuse its vertices in place, gives one thread's vertices and
+    /// projections, for the bunny seen far and so near that vertices leave the
+    /// frustum and the guard band.
+    #[test]
+    fn vertex_stage_on_threads_equals_one_threads_frame_after_frame() {
+        use glam::{Mat4, Vec3};
+
+        use crate::camera::Camera;
+        use crate::mesh::Mesh;
+        use crate::render::shaders::Lambert;
+        use crate::render::{Renderer, transform};
+
+        let mesh = Mesh::bunny();
+        let target = Target::new(123, 77);
+        let mut r = Renderer::new(target);
+        r.set_threads(2);
+        r.min_parallel_vertices = 0;
+        let mut shared = VertexCache::default();
+        let n = mesh.positions.len();
+        for eye in [
+            Vec3::new(0.3, 0.5, 3.0),
+            Vec3::new(0.0, 0.2, 0.4),
+            Vec3::Z * 2.0,
+        ] {
+            let cam = Camera {
+                eye,
+                ..Camera::default()
+            };
+            let view_proj = cam.projection(target.width, target.height, 1.0) * cam.view();
+            let shader = Lambert::new(&mesh, Mat4::IDENTITY, view_proj);
+            let mut one = VertexCache::default();
+            transform(&shader, n, &mut one);
+            let mut projected = Vec::new();
+            project_vertices(&one, target, &mut projected);
+            r.transform(&shader, n, &mut shared);
+            assert_eq!(format!("{:?}", one.verts), format!("{:?}", shared.verts));
+            let pv = shared.projections(target).expect("made on the threads");
+            assert_eq!(format!("{projected:?}"), format!("{pv:?}"), "{eye}");
+        }
+    }
 
     /// Every vertex gets the projection one thread gives it, for meshes of no vertex,
     /// fewer than a piece, and pieces that do not divide the count, from a pool of

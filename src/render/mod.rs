@@ -269,7 +269,7 @@ impl Renderer {
                         .map(vertex),
                 );
             }
-            let projected = prepare::slots(&mut cache.projected, vertex_count);
+            let projected = prepare::one_per_vertex(&mut cache.projected, vertex_count);
             cache
                 .verts
                 .par_chunks_mut(tiles::VERTEX_JOB)

@@ -18,7 +18,7 @@ use crate::raster::{SUBPIXEL_BITS, Setup, Target};
 use crate::simd::each3;
 
 mod lanes;
-pub(crate) use lanes::{project_into, slots};
+pub(crate) use lanes::{one_per_vertex, project_into};
 
 /// A triangle after clipping and projection, ready to rasterize. Vertex arrays are in
 /// setup order (A, B, C after any winding flip).
@@ -104,10 +104,10 @@ pub fn transform<S: Shader>(shader: &S, vertex_count: usize, cache: &mut VertexC
     }));
 }
 
-/// [`transform`] and [`project_vertices`] for `target` in one pass: each vertex is
-/// projected while it is in registers, instead of being read back from a cache that
-/// a large mesh has long pushed out of the processor's (a million-triangle mesh's
-/// vertices are some 25 MB).
+/// [`transform`] and [`project_vertices`] for `target` in one pass: each block of
+/// vertices is projected while it is in the L1 cache, instead of being read back from
+/// memory once a large mesh has pushed it out of the processor's caches (a
+/// million-triangle mesh's vertices are some 25 MB).
 pub fn transform_projected<S: Shader>(
     shader: &S,
     vertex_count: usize,
@@ -118,7 +118,7 @@ pub fn transform_projected<S: Shader>(
     cache.verts.reserve(vertex_count);
     // Blocks small enough that their vertices are still in the L1 cache when projected.
     const BLOCK: usize = 64;
-    for (b, out) in slots(&mut cache.projected, vertex_count)
+    for (b, out) in one_per_vertex(&mut cache.projected, vertex_count)
         .chunks_mut(BLOCK)
         .enumerate()
     {
@@ -237,7 +237,7 @@ where
 
 /// Projects every vertex of `cache` for `target` into `out` (reusing its storage).
 pub fn project_vertices<V>(cache: &VertexCache<V>, target: Target, out: &mut Vec<Projected>) {
-    project_into(&cache.verts, target, slots(out, cache.verts.len()));
+    project_into(&cache.verts, target, one_per_vertex(out, cache.verts.len()));
 }
 
 /// Clips, projects and sets up mesh triangle `t`, calling `emit` for each piece that

@@ -13,7 +13,7 @@ use crate::simd::{F32s, I32s};
 
 /// `out` with one slot per vertex of `n`, its old contents left in place where it
 /// already had `n` (a steady frame), to be overwritten.
-pub(crate) fn slots(out: &mut Vec<Projected>, n: usize) -> &mut [Projected] {
+pub(crate) fn one_per_vertex(out: &mut Vec<Projected>, n: usize) -> &mut [Projected] {
     if out.len() != n {
         out.clear();
         out.resize(n, Projected::default());

@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use super::VERTEX_JOB;
 use super::queue::lock;
 use crate::raster::Target;
-use crate::render::prepare::{Projected, VertexCache, project_into, slots};
+use crate::render::prepare::{Projected, VertexCache, one_per_vertex, project_into};
 
 /// The most pieces [`project_claimed`] cuts the vertices into.
 const PIECES: usize = 64;
@@ -43,7 +43,7 @@ fn project_claimed<V: Sync>(cache: &VertexCache<V>, target: Target, out: &mut Ve
         out.clear();
         return;
     }
-    let out = slots(out, verts.len());
+    let out = one_per_vertex(out, verts.len());
     let piece = VERTEX_JOB.max(verts.len().div_ceil(PIECES));
     let slots: [Mutex<Option<&mut [Projected]>>; PIECES] =
         std::array::from_fn(|_| Mutex::new(None));

@@ -19,10 +19,11 @@ const MAX_QUEUES: usize = 16;
 
 /// Which band each thread walks next. Each thread has a home run of consecutive bands
 /// (as many as the others), which it walks costliest first; a thread whose run is done
-/// takes the cheapest band left in the longest other run. The costly bands are thus
-/// walked early and the cheap ones last, so the threads finish together. The runs are
-/// cut by count rather than by cost, so they stay the same from frame to frame
-/// (measured: a split by cost is slower on the teapot).
+/// takes the costliest band left in the longest other run. The costly bands are thus
+/// walked early and the cheap ones last, wherever they lie, so the threads finish
+/// together (taking the cheapest instead left the owner a band of middle cost to end
+/// on alone). The runs are cut by count rather than by cost, so they stay the same
+/// from frame to frame (measured: a split by cost is slower on the teapot).
 #[derive(Debug, PartialEq, Eq)]
 pub(super) struct Queues {
     /// Per thread, the next and the end position of its run in the band order.
@@ -56,8 +57,8 @@ impl Queues {
         if self.front[other] == self.back[other] {
             return None;
         }
-        self.back[other] -= 1;
-        Some(self.back[other])
+        self.front[other] += 1;
+        Some(self.front[other] - 1)
     }
 }
 
@@ -143,7 +144,7 @@ mod tests {
     use super::*;
 
     /// Every band is handed out exactly once, whoever asks: a thread first walks its
-    /// own run in order, then takes from the back of the longest other run.
+    /// own run in order, then takes from the front of the longest other run.
     #[test]
     fn every_band_is_handed_out_once() {
         for bands in 0..40 {
@@ -164,7 +165,7 @@ mod tests {
     }
 
     #[test]
-    fn a_thread_walks_its_run_then_the_cheapest_of_the_longest_other() {
+    fn a_thread_walks_its_run_then_the_costliest_of_the_longest_other() {
         let mut q = Queues::new(10, 2);
         assert_eq!(
             (q.front[0], q.back[0], q.front[1], q.back[1]),
@@ -175,12 +176,25 @@ mod tests {
             [0, 1, 2, 3, 4].map(Some)
         );
         assert_eq!(q.take(1), Some(5));
-        // Thread 0's run is done: it takes run 1's last (cheapest) position.
-        assert_eq!(q.take(0), Some(9));
-        assert_eq!(q.take(1), Some(6));
-        assert_eq!(q.take(0), Some(8));
+        // Thread 0's run is done: it takes run 1's next (costliest left) position.
+        assert_eq!(q.take(0), Some(6));
         assert_eq!(q.take(1), Some(7));
+        assert_eq!(q.take(0), Some(8));
+        assert_eq!(q.take(1), Some(9));
         assert_eq!((q.take(0), q.take(1)), (None, None));
+        // With three runs, a thread done with its own takes from the longest other.
+        let mut q = Queues::new(9, 3);
+        assert_eq!(
+            (0..3).map(|_| q.take(0)).collect::<Vec<_>>(),
+            [0, 1, 2].map(Some)
+        );
+        assert_eq!(q.take(2), Some(6));
+        assert_eq!(q.take(0), Some(3), "run 1 is the longest left");
+        assert_eq!(
+            q.take(0),
+            Some(7),
+            "runs 1 and 2 are as long: the later one"
+        );
     }
 
     #[test]

@@ -9,8 +9,9 @@
 //!    those of a small mesh, projects them here, the same way: `vertices`).
 //! 2. **Set-up and binning**: the triangles are cut into chunks of consecutive
 //!    triangles; each chunk's thread clips and sets up its triangles once
-//!    ([`prepare_projected`], as on one thread) into the chunk's records, in draw order,
-//!    and files each record's index in the bin of every band its box touches.
+//!    ([`super::prepare_projected`], as on one thread) into the chunk's records, in
+//!    draw order, and files each record's index in the bin of every band its box
+//!    touches (`bins`).
 //! 3. **Walk**: each band is walked by one thread, which takes the bins of every
 //!    chunk in chunk order: the triangles of a band reach its depth test and its
 //!    colour writes in draw order, as on one thread. A triangle that crosses bands is
@@ -41,9 +42,7 @@ use rayon::prelude::*;
 use super::fragments::PieceWalker;
 use super::isa::DrawVariant;
 use super::options::{DrawOptions, DrawStats};
-use super::prepare::{
-    EmitPiece, PrepareOutcome, Prepared, Projected, VertexCache, prepare_projected,
-};
+use super::prepare::{Projected, VertexCache};
 use super::shader::Shader;
 use super::target::ColorTarget;
 use super::{Renderer, Spread};
@@ -53,9 +52,12 @@ use crate::simd::{I32s, prefetch};
 use queue::plan_bands;
 use vertices::projections;
 
+mod bins;
 mod queue;
 pub mod strips;
 mod vertices;
+
+pub(super) use bins::{Chunk, setup_chunk};
 
 /// The tallest band: a multiple of the block traversal's 8 and of the depth clear
 /// tile. Chosen by measurement (see `docs/performance.md`).
@@ -80,53 +82,6 @@ const CHUNKS_PER_THREAD: usize = 4;
 /// vertices is shared out, which wakes the pool before the set-up needs it (smaller
 /// jobs cost more to hand out than they save).
 pub(super) const VERTEX_JOB: usize = 512;
-
-/// What a piece costs the walk of a band besides its pixels, in pixels (the walk's
-/// per-triangle set-up: its first row's edge values and groups).
-const RECORD_COST: u64 = 24;
-
-/// A run of consecutive triangles set up by one thread.
-#[derive(Debug)]
-pub(super) struct Chunk<V> {
-    /// The pieces that reached the rasterizer, in draw order.
-    records: Vec<Prepared<V>>,
-    /// The bins, one after another: band `b`'s is `entries[starts[b]..starts[b + 1]]`,
-    /// the indices in `records` of the pieces whose box touches it, ascending. One
-    /// array per chunk keeps the memory in proportion to the pieces, whatever the
-    /// number of bands.
-    entries: Vec<u32>,
-    /// Where each band's bin starts in `entries`, and where the last ends (while
-    /// binning, `starts[b + 1]` counts band `b`'s pieces).
-    starts: Vec<u32>,
-    /// Per record, the first and last band its box touches: what filling the bins
-    /// reads, instead of each record's cache line again.
-    spans: Vec<[u16; 2]>,
-    /// Per band, the work its bin holds: box pixels in the band plus [`RECORD_COST`]
-    /// per piece (the order bands are walked in: `queue::plan_bands`).
-    cost: Vec<u64>,
-    /// The triangle counters of the chunk (the fragment counters come from the walk).
-    stats: DrawStats,
-}
-
-impl<V> Chunk<V> {
-    /// The indices in `records` of band `band`'s pieces, in draw order.
-    fn bin(&self, band: usize) -> &[u32] {
-        &self.entries[self.starts[band] as usize..self.starts[band + 1] as usize]
-    }
-}
-
-impl<V> Default for Chunk<V> {
-    fn default() -> Self {
-        Self {
-            records: Vec::new(),
-            entries: Vec::new(),
-            starts: Vec::new(),
-            spans: Vec::new(),
-            cost: Vec::new(),
-            stats: DrawStats::default(),
-        }
-    }
-}
 
 /// Every chunk of a draw, for one varying type.
 #[derive(Debug)]
@@ -375,119 +330,6 @@ pub fn band_rows(target: Target, threads: usize, triangles: usize) -> u32 {
     (per / 8 * 8).clamp(8, tallest)
 }
 
-/// Files each piece into its chunk and counts it in the bins of the bands its box
-/// touches ([`fill_bins`] then places it).
-struct Binner<'a, V> {
-    chunk: &'a mut Chunk<V>,
-    band_rows: u32,
-}
-
-impl<V: Copy> EmitPiece<V> for Binner<'_, V> {
-    #[inline(always)]
-    fn piece(&mut self, p: &Prepared<V>) {
-        let b = p.setup.bbox;
-        // A box of at most four pixels covering none of them (most triangles of a mesh
-        // far denser than the pixels) would be walked for nothing: it is not stored.
-        // The stale depth tiles the walk would have filled read as cleared anyway.
-        if b.width() * b.height() <= 4 && !covers_any(&p.setup) {
-            return;
-        }
-        let c = &mut *self.chunk;
-        c.records.push(*p);
-        let rows = self.band_rows;
-        // Bands fit 16 bits: a target is at most 2^16 rows and a band at least 8.
-        c.spans.push([(b.y0 / rows) as u16, (b.y1 / rows) as u16]);
-        for band in b.y0 / rows..b.y1 / rows + 1 {
-            c.starts[band as usize + 1] += 1;
-            let y0 = b.y0.max(band * rows);
-            let y1 = b.y1.min(band * rows + rows - 1);
-            c.cost[band as usize] += u64::from((y1 - y0 + 1) * b.width()) + RECORD_COST;
-        }
-    }
-}
-
-/// Whether any pixel of a setup's box is covered.
-#[inline(always)]
-fn covers_any(s: &Setup) -> bool {
-    let b = s.bbox;
-    for y in b.y0..=b.y1 {
-        for x in b.x0..=b.x1 {
-            let f = s.edges(i64::from(x), i64::from(y));
-            if f[0] >= 0 && f[1] >= 0 && f[2] >= 0 {
-                return true;
-            }
-        }
-    }
-    false
-}
-
-/// Sets up triangles `range` of the draw into `chunk`, counting them as one thread
-/// does: the body of every copy's [`TileCopy::setup`].
-#[inline(always)]
-pub(super) fn setup_chunk<S: Shader>(
-    job: &Job<'_, S>,
-    range: Range<u32>,
-    chunk: &mut Chunk<S::Varying>,
-) {
-    // Room for a piece per triangle of the range (unless clipping splits one), each in
-    // two bands: kept from draw to draw, so a model turning into new shapes does not
-    // grow them frame after frame.
-    let room = range.len();
-    chunk.records.clear();
-    chunk.records.reserve(room);
-    chunk.entries.clear();
-    chunk.entries.reserve(2 * room);
-    chunk.spans.clear();
-    chunk.spans.reserve(room);
-    chunk.starts.fill(0);
-    chunk.cost.fill(0);
-    let mut stats = DrawStats::default();
-    let mut binner = Binner {
-        chunk,
-        band_rows: job.band_rows,
-    };
-    let pv = Some(job.projected);
-    for t in range {
-        stats.triangles += 1;
-        let (cache, indices, target, cull) = (job.cache, job.indices, job.target, job.opts.cull);
-        match prepare_projected(cache, pv, indices, t, target, cull, &mut binner) {
-            PrepareOutcome::Rejected => stats.rejected += 1,
-            PrepareOutcome::Culled => stats.culled += 1,
-            PrepareOutcome::Drawn { clipped } => {
-                stats.drawn += 1;
-                stats.clipped += u64::from(clipped);
-            }
-        }
-    }
-    binner.chunk.stats = stats;
-    fill_bins(binner.chunk);
-}
-
-/// Places every record's index in the bins its box touches, once the records are
-/// counted per band: a counting sort, so each bin is in draw order.
-#[inline(always)]
-fn fill_bins<V>(c: &mut Chunk<V>) {
-    // Counts to starts: starts[b] is where band b's bin begins.
-    for b in 1..c.starts.len() {
-        c.starts[b] += c.starts[b - 1];
-    }
-    let total = c.starts.last().copied().unwrap_or(0) as usize;
-    c.entries.resize(total, 0);
-    // Each record at its band's next free place; starts[b] then holds the bin's end,
-    // which is where band b + 1's begins.
-    for (i, &[first, last]) in c.spans.iter().enumerate() {
-        for band in usize::from(first)..=usize::from(last) {
-            c.entries[c.starts[band] as usize] = i as u32;
-            c.starts[band] += 1;
-        }
-    }
-    // Back to starts (the last, the total, was never moved and rotates to the front).
-    c.starts.rotate_right(1);
-    if let Some(first) = c.starts.first_mut() {
-        *first = 0;
-    }
-}
-
 /// Walks band `band` (its rows of `color` and `depth`) through every chunk's bin in
 /// chunk order, so in draw order, with variant `V` on lanes `L`: the body of every
 /// copy's [`TileCopy::walk`].
@@ -539,31 +381,8 @@ pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
 
 #[cfg(test)]
 mod tests {
-    use super::{BAND_ROWS, Chunk, DENSE_BAND_ROWS, band_rows, fill_bins};
+    use super::{BAND_ROWS, DENSE_BAND_ROWS, band_rows};
     use crate::raster::Target;
-
-    /// Each band's bin holds exactly the records whose span covers it, in draw order.
-    #[test]
-    fn bins_hold_each_band_s_records_in_order() {
-        let spans = [[0, 2], [1, 1], [2, 3], [0, 0], [3, 3], [1, 3]];
-        let mut c = Chunk::<()> {
-            starts: vec![0; 5],
-            spans: spans.to_vec(),
-            ..Chunk::default()
-        };
-        for &[a, b] in &spans {
-            for band in a..=b {
-                c.starts[usize::from(band) + 1] += 1;
-            }
-        }
-        fill_bins(&mut c);
-        for band in 0..4u16 {
-            let want: Vec<u32> = (0..spans.len() as u32)
-                .filter(|&i| (spans[i as usize][0]..=spans[i as usize][1]).contains(&band))
-                .collect();
-            assert_eq!(c.bin(usize::from(band)), want, "band {band}");
-        }
-    }
 
     /// Bands are whole blocks of 8 rows, at most `BAND_ROWS`, and about six per
     /// thread wherever the target is tall enough for that; a dense draw's at most

@@ -6,7 +6,7 @@
 use wide::{f32x8, i32x8};
 
 use super::Projected;
-use crate::raster::clip::{ClipVertex, OUT_NOT_FINITE, guard_band_ndc};
+use crate::raster::clip::{ClipVertex, OUT_NOT_FINITE, OUT_W_NOT_POSITIVE, guard_band_ndc};
 use crate::raster::setup::GUARD_BAND_PX;
 use crate::raster::{SUBPIXEL_ONE, Target};
 use crate::simd::{F32s, I32s};
@@ -64,6 +64,9 @@ fn transpose8(mut x: u64) -> u64 {
     let t = (x ^ (x >> 28)) & 0x0000_0000_F0F0_F0F0;
     x ^ t ^ (t << 28)
 }
+
+// The outcode bits `project8` gathers by position: planes 0–5, then these two.
+const _: () = assert!(OUT_W_NOT_POSITIVE == 1 << 6 && OUT_NOT_FINITE == 1 << 7);
 
 /// Eight vertices' projections (see [`Projected::of`] for each field).
 #[inline(always)]

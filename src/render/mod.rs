@@ -256,10 +256,7 @@ impl Renderer {
             // A steady frame transforms into the vertices of the last and projects each
             // piece while it is in the cache; a new vertex count makes room first.
             let fresh = cache.verts.len() != vertex_count;
-            let vertex = |i: usize| {
-                let (pos, var) = shader.vertex(i as u32);
-                crate::raster::clip::ClipVertex { pos, var }
-            };
+            let vertex = |i| prepare::clip_vertex(shader, i);
             if fresh {
                 cache.verts.clear();
                 cache.verts.par_extend(

@@ -98,10 +98,16 @@ pub enum PrepareOutcome {
 pub fn transform<S: Shader>(shader: &S, vertex_count: usize, cache: &mut VertexCache<S::Varying>) {
     cache.projected_for = None;
     cache.verts.clear();
-    cache.verts.extend((0..vertex_count as u32).map(|i| {
-        let (pos, var) = shader.vertex(i);
-        ClipVertex { pos, var }
-    }));
+    cache
+        .verts
+        .extend((0..vertex_count).map(|i| clip_vertex(shader, i)));
+}
+
+/// Vertex `i` through `shader`'s vertex stage: what every form of [`transform`] stores.
+#[inline(always)]
+pub(crate) fn clip_vertex<S: Shader>(shader: &S, i: usize) -> ClipVertex<S::Varying> {
+    let (pos, var) = shader.vertex(i as u32);
+    ClipVertex { pos, var }
 }
 
 /// [`transform`] and [`project_vertices`] for `target` in one pass: each block of
@@ -123,10 +129,9 @@ pub fn transform_projected<S: Shader>(
         .enumerate()
     {
         let first = b * BLOCK;
-        cache.verts.extend((first..first + out.len()).map(|i| {
-            let (pos, var) = shader.vertex(i as u32);
-            ClipVertex { pos, var }
-        }));
+        cache
+            .verts
+            .extend((first..first + out.len()).map(|i| clip_vertex(shader, i)));
         project_into(&cache.verts[first..], target, out);
     }
     cache.projected_for = Some(target);
@@ -396,13 +401,23 @@ fn setup_piece<V: Varying>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use glam::{Mat4, Vec3};
 
     use super::*;
     use crate::camera::Camera;
     use crate::mesh::Mesh;
     use crate::render::shaders::Lambert;
+
+    /// A Lambert shader for `mesh` seen from `eye` by the default camera into `target`.
+    pub(crate) fn lambert_from(mesh: &Mesh, eye: Vec3, target: Target) -> Lambert<'_> {
+        let cam = Camera {
+            eye,
+            ..Camera::default()
+        };
+        let view_proj = cam.projection(target.width, target.height, 1.0) * cam.view();
+        Lambert::new(mesh, Mat4::IDENTITY, view_proj)
+    }
 
     /// The vertex stage with its projections made in the same pass gives the vertices
     /// of [`transform`] and the projections of [`project_vertices`], bit for bit, and
@@ -413,12 +428,7 @@ mod tests {
         let target = Target::new(123, 77);
         // Far, and so near that vertices leave the frustum and the guard band.
         for eye in [Vec3::new(0.3, 0.5, 3.0), Vec3::new(0.0, 0.2, 0.4)] {
-            let cam = Camera {
-                eye,
-                ..Camera::default()
-            };
-            let view_proj = cam.projection(target.width, target.height, 1.0) * cam.view();
-            let shader = Lambert::new(&mesh, Mat4::IDENTITY, view_proj);
+            let shader = lambert_from(&mesh, eye, target);
             let n = mesh.positions.len();
             let (mut apart, mut fused) = (VertexCache::default(), VertexCache::default());
             transform(&shader, n, &mut apart);

@@ -80,11 +80,10 @@ mod tests {
     /// frustum and the guard band.
     #[test]
     fn vertex_stage_on_threads_equals_one_threads_frame_after_frame() {
-        use glam::{Mat4, Vec3};
+        use glam::Vec3;
 
-        use crate::camera::Camera;
         use crate::mesh::Mesh;
-        use crate::render::shaders::Lambert;
+        use crate::render::prepare::tests::lambert_from;
         use crate::render::{Renderer, transform};
 
         let mesh = Mesh::bunny();
@@ -99,12 +98,7 @@ mod tests {
             Vec3::new(0.0, 0.2, 0.4),
             Vec3::Z * 2.0,
         ] {
-            let cam = Camera {
-                eye,
-                ..Camera::default()
-            };
-            let view_proj = cam.projection(target.width, target.height, 1.0) * cam.view();
-            let shader = Lambert::new(&mesh, Mat4::IDENTITY, view_proj);
+            let shader = lambert_from(&mesh, eye, target);
             let mut one = VertexCache::default();
             transform(&shader, n, &mut one);
             let mut projected = Vec::new();

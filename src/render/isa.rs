@@ -252,7 +252,8 @@ pub(super) mod baseline {
 
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
-    use crate::render::tiles::{self, Chunk, Job, TileCopy, strips};
+    use crate::render::tiles::strips::{self, StripPlan};
+    use crate::render::tiles::{self, Chunk, Job, TileCopy};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
     /// The threaded draw's steps of variant `V` on [`wide`]'s portable lanes.
@@ -278,13 +279,13 @@ pub(super) mod baseline {
         }
         unsafe fn strip<S: Shader, C: ColorTarget>(
             job: &Job<'_, S>,
-            ends: &[u32],
+            plan: &StripPlan<'_>,
             strip: usize,
             color: &mut C,
             depth: &mut DepthRows<'_>,
             clear: Option<Vec3>,
         ) -> DrawStats {
-            strips::draw_strip::<V, S, C, wide::i32x8>(job, ends, strip, color, depth, clear)
+            strips::draw_strip::<V, S, C, wide::i32x8>(job, plan, strip, color, depth, clear)
         }
     }
 
@@ -312,7 +313,8 @@ pub(super) mod avx2 {
 
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
-    use crate::render::tiles::{self, Chunk, Job, TileCopy, strips};
+    use crate::render::tiles::strips::{self, StripPlan};
+    use crate::render::tiles::{self, Chunk, Job, TileCopy};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
     /// The threaded draw's steps of variant `V`, compiled as [`draw`] is.
@@ -340,14 +342,14 @@ pub(super) mod avx2 {
         }
         unsafe fn strip<S: Shader, C: ColorTarget>(
             job: &Job<'_, S>,
-            ends: &[u32],
+            plan: &StripPlan<'_>,
             strip: usize,
             color: &mut C,
             depth: &mut DepthRows<'_>,
             clear: Option<Vec3>,
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
-            unsafe { self::strip::<V, S, C>(job, ends, strip, color, depth, clear) }
+            unsafe { self::strip::<V, S, C>(job, plan, strip, color, depth, clear) }
         }
     }
 
@@ -385,14 +387,14 @@ pub(super) mod avx2 {
     #[target_feature(enable = "avx2,fma,popcnt,bmi1")]
     unsafe fn strip<V: DrawVariant, S: Shader, C: ColorTarget>(
         job: &Job<'_, S>,
-        ends: &[u32],
+        plan: &StripPlan<'_>,
         strip: usize,
         color: &mut C,
         depth: &mut DepthRows<'_>,
         clear: Option<Vec3>,
     ) -> DrawStats {
         strips::draw_strip::<V, S, C, crate::simd::avx2::I32x8>(
-            job, ends, strip, color, depth, clear,
+            job, plan, strip, color, depth, clear,
         )
     }
 
@@ -428,7 +430,8 @@ pub(super) mod avx512 {
 
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
-    use crate::render::tiles::{self, Chunk, Job, TileCopy, strips};
+    use crate::render::tiles::strips::{self, StripPlan};
+    use crate::render::tiles::{self, Chunk, Job, TileCopy};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
     /// The threaded draw's steps, compiled as [`draw`] is.
@@ -456,14 +459,14 @@ pub(super) mod avx512 {
         }
         unsafe fn strip<S: Shader, C: ColorTarget>(
             job: &Job<'_, S>,
-            ends: &[u32],
+            plan: &StripPlan<'_>,
             strip: usize,
             color: &mut C,
             depth: &mut DepthRows<'_>,
             clear: Option<Vec3>,
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
-            unsafe { self::strip::<S, C>(job, ends, strip, color, depth, clear) }
+            unsafe { self::strip::<S, C>(job, plan, strip, color, depth, clear) }
         }
     }
 
@@ -501,14 +504,14 @@ pub(super) mod avx512 {
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,avx512f,avx512vl,avx512bw,avx512dq")]
     unsafe fn strip<S: Shader, C: ColorTarget>(
         job: &Job<'_, S>,
-        ends: &[u32],
+        plan: &StripPlan<'_>,
         strip: usize,
         color: &mut C,
         depth: &mut DepthRows<'_>,
         clear: Option<Vec3>,
     ) -> DrawStats {
         strips::draw_strip::<Fast, S, C, crate::simd::avx512::I32x16>(
-            job, ends, strip, color, depth, clear,
+            job, plan, strip, color, depth, clear,
         )
     }
 

@@ -74,7 +74,7 @@ pub use prepare::{
 };
 pub use shader::{ShadeLanes, Shader};
 pub use target::{ColorTarget, Rgba8, Rgba8Rows};
-pub use tiles::strips::{MAX_STRIPS, strip_ends};
+pub use tiles::strips::{ALL_ROWS, MAX_STRIPS, strip_ends, vertex_spans};
 pub use tiles::{BAND_ROWS, DENSE_BAND_ROWS, band_rows};
 
 /// Owns the depth buffer and frame counters; draws meshes into a colour target.

@@ -189,24 +189,16 @@ impl Projected {
         }
     }
 
-    /// The pixel row of a vertex inside every plane and snapped (unclamped to the
-    /// target): where a frame's work lies, for sharing its rows among threads.
+    /// The first and last row of the box of a triangle with this vertex alone
+    /// ([`box_rows`], unclamped to the target), if the vertex is inside every plane
+    /// and snapped; `None` if a triangle with it needs clipping or is rejected. A box
+    /// is monotone in its vertices, so a triangle drawn unclipped has the rows from
+    /// the least first row to the greatest last row of its three vertices.
     #[inline(always)]
     #[must_use]
-    pub(crate) fn row(&self) -> Option<i64> {
-        (self.out == 0 && self.snapped).then_some(self.fixed[1] >> SUBPIXEL_BITS)
-    }
-
-    /// The first and last row of the box of a triangle of these vertices (unclamped
-    /// to the target) if it is drawn unclipped (inside every plane, every vertex
-    /// snapped); `None` for one that needs clipping or is rejected, whose rows only
-    /// [`prepare_projected`] knows.
-    #[inline(always)]
-    #[must_use]
-    pub(crate) fn unclipped_rows(pv: [Self; 3]) -> Option<[i64; 2]> {
-        let inside = classify_codes(each3!(|i| pv[i].out)) == ClipOutcome::Inside;
-        (inside && pv[0].snapped && pv[1].snapped && pv[2].snapped)
-            .then(|| box_rows(&each3!(|i| pv[i].fixed)))
+    pub(crate) fn rows(&self) -> Option<[i64; 2]> {
+        let inside = classify_codes([self.out; 3]) == ClipOutcome::Inside;
+        (inside && self.snapped).then(|| box_rows(&[self.fixed; 3]))
     }
 
     /// Whether a triangle of these vertices surely leaves pixel `(x, y)` alone: it is

@@ -50,6 +50,7 @@ use crate::raster::depth::DepthRows;
 use crate::raster::{Setup, Target};
 use crate::simd::{I32s, prefetch};
 use queue::plan_bands;
+use strips::StripPlan;
 use vertices::projections;
 
 mod bins;
@@ -101,6 +102,8 @@ pub(super) struct Scratch {
     cost: Vec<u64>,
     /// Per 8 rows, the vertices there (`strips`: where a small frame's work lies).
     pub(super) rows: Vec<u32>,
+    /// Per vertex, the rows a box takes from it (`strips::vertex_spans`).
+    pub(super) spans: Vec<u32>,
 }
 
 impl std::fmt::Debug for Scratch {
@@ -176,16 +179,15 @@ pub(super) trait TileCopy {
         clear: Option<Vec3>,
     ) -> DrawStats;
 
-    /// Draws strip `strip` (of those ending at rows `ends`) of every triangle into its
-    /// rows of colour and depth, first
-    /// filling the colour rows with `clear` if given (see [`strips::draw_strip`]);
-    /// returns its counters.
+    /// Draws strip `strip` of `plan`'s of every triangle into its rows of colour and
+    /// depth, first filling the colour rows with `clear` if given (see
+    /// [`strips::draw_strip`]); returns its counters.
     ///
     /// # Safety
     /// As for [`TileCopy::setup`].
     unsafe fn strip<S: Shader, C: ColorTarget>(
         job: &Job<'_, S>,
-        ends: &[u32],
+        plan: &StripPlan<'_>,
         strip: usize,
         color: &mut C,
         depth: &mut DepthRows<'_>,

@@ -14,7 +14,7 @@ use termrast::render::probe::DepthOutcome;
 use termrast::render::target::to_u8;
 use termrast::render::{
     BAND_ROWS, DENSE_BAND_ROWS, DrawOptions, DrawStats, Isa, Renderer, Spread, VertexCache,
-    band_rows, project_vertices, strip_ends,
+    band_rows, project_vertices, strip_ends, vertex_spans,
 };
 use termrast::scene::Scene;
 use termrast::scene::render::{SceneFrame, SceneView};
@@ -336,7 +336,9 @@ fn triangles_crossing_a_band_border_at_every_subpixel_draw_the_same() {
         termrast::render::transform(&shader, shader.clip.len(), &mut cache);
         let mut pv = Vec::new();
         project_vertices(&cache, target, &mut pv);
-        let ends = strip_ends(&pv, target.height, 2, &mut Vec::new()).0;
+        let mut spans = Vec::new();
+        vertex_spans(&pv, target.height, &mut spans);
+        let ends = strip_ends(&spans, target.height, 2, &mut Vec::new()).0;
         assert_eq!(
             ends[0], border as u32,
             "{target:?} {sub}: the strips' border"

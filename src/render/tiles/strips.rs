@@ -5,10 +5,12 @@
 //! terminal size) is done in well under a millisecond; binning ([`super::draw`])
 //! then costs more than the second thread saves, as its set-up records go through
 //! memory between two parallel steps. Here there is one step: each thread scans the
-//! triangles in draw order, skips those whose box (known from the projected vertices
-//! alone) misses its strip, and sets up and walks the others with their boxes cut to
-//! its rows ([`Setup::rows`]), as one thread would. Only triangles crossing a strip's
-//! border are set up twice.
+//! triangles in draw order, skips those whose box misses its strip, and sets up and
+//! walks the others with their boxes cut to its rows ([`Setup::rows`]), as one thread
+//! would. Only triangles crossing a strip's border are set up twice. The scan reads
+//! one word per vertex, the rows a box takes from it ([`vertex_spans`]), made once
+//! before the strips start: the box's rows run from the least first row of its
+//! vertices to the greatest last row.
 //!
 //! The strips hold about as many vertices each (counted per 8 rows before the draw),
 //! so the threads finish together. The strips are worth it only to a caller that runs
@@ -42,6 +44,20 @@ use crate::simd::I32s;
 
 /// The most strips a draw is cut into: a larger pool leaves its other threads idle.
 pub const MAX_STRIPS: usize = 16;
+
+/// A vertex's [`vertex_spans`] entry when a triangle with it needs clipping or is
+/// rejected: from row 0 to every row, so every strip sets the triangle up and the first
+/// counts it. A vertex of a triangle drawn unclipped never has it, as its first row
+/// (clamped) is its last or the next.
+pub const ALL_ROWS: u32 = 0xffff_0000;
+
+/// What every strip of a draw reads besides the [`Job`].
+pub(in crate::render) struct StripPlan<'a> {
+    /// The row each strip ends at (exclusive); the last is the target's height.
+    pub ends: &'a [u32],
+    /// Per vertex, the rows a box takes from it ([`vertex_spans`]).
+    pub spans: &'a [u32],
+}
 
 /// The longest the first strip's thread spins waiting for the others before it
 /// waits as rayon does (by sleeping once nothing is left to steal).
@@ -81,14 +97,14 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> StripWalk<S::Varying>
     }
 }
 
-/// Draws strip `strip` of those ending at rows `ends` (its rows of `color` and
-/// `depth`) of every triangle of the draw, first filling the colour rows with `clear`
-/// if given, with variant `V` on lanes `L`; returns the strip's counters. The body of
-/// every copy's [`TileCopy::strip`].
+/// Draws strip `strip` of `plan`'s (its rows of `color` and `depth`) of every
+/// triangle of the draw, first filling the colour rows with `clear` if given, with
+/// variant `V` on lanes `L`; returns the strip's counters. The body of every copy's
+/// [`TileCopy::strip`].
 #[inline(always)]
 pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
     job: &Job<'_, S>,
-    ends: &[u32],
+    plan: &StripPlan<'_>,
     strip: usize,
     color: &mut C,
     depth: &mut DepthRows<'_>,
@@ -98,18 +114,17 @@ pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L
         let len = color.len();
         color.reset(len, background);
     }
-    let y0 = if strip == 0 { 0 } else { ends[strip - 1] };
-    let y1 = ends[strip] - 1;
-    let last_row = i64::from(job.target.height) - 1;
+    let y0 = if strip == 0 { 0 } else { plan.ends[strip - 1] };
+    let y1 = plan.ends[strip] - 1;
     let mut walker =
         PieceWalker::<S, C, L, V, _>::new(job.shader, depth, color, &job.opts, job.target);
     let mut stats = DrawStats::default();
-    let (indices, projected) = (job.indices, job.projected);
+    let (indices, projected, spans) = (job.indices, job.projected, plan.spans);
     let n = (indices.len() / 3) as u32;
     for t in 0..n {
         let base = t as usize * 3;
-        let vertex = |k: usize| projected.get(indices[base + k] as usize).copied();
-        let (Some(a), Some(b), Some(c)) = (vertex(0), vertex(1), vertex(2)) else {
+        let span = |k: usize| spans.get(indices[base + k] as usize).copied();
+        let (Some(a), Some(b), Some(c)) = (span(0), span(1), span(2)) else {
             // A vertex out of range: rejected, counted by the first strip.
             if strip == 0 {
                 stats.triangles += 1;
@@ -117,24 +132,20 @@ pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L
             }
             continue;
         };
-        let owner = match Projected::unclipped_rows([a, b, c]) {
-            Some([top, bottom]) => {
-                let first = top.clamp(0, last_row) as u32;
-                let owner = ends.iter().position(|&e| first < e).unwrap_or(0);
-                if owner != strip && (bottom < i64::from(y0) || top > i64::from(y1)) {
-                    continue;
-                }
-                owner
-            }
-            None => 0,
-        };
+        // The box's first row (clamped to the target) is in its owner's strip.
+        let top = (a & 0xffff).min(b & 0xffff).min(c & 0xffff);
+        let bottom = (a >> 16).max(b >> 16).max(c >> 16);
+        let owner = (y0..=y1).contains(&top);
+        if !owner && (bottom < y0 || top > y1) {
+            continue;
+        }
         let mut cut = Cut {
             walker: &mut walker,
             rows: [y0, y1],
         };
         let (cache, target, cull) = (job.cache, job.target, job.opts.cull);
         let outcome = prepare_projected(cache, Some(projected), indices, t, target, cull, &mut cut);
-        if owner == strip {
+        if owner {
             stats.triangles += 1;
             match outcome {
                 PrepareOutcome::Rejected => stats.rejected += 1,
@@ -151,13 +162,26 @@ pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L
     stats
 }
 
+/// Fills `spans` with one word per vertex of `projected` for a target `height` rows
+/// high: `first | last << 16`, the first and last row (clamped to the target) of the
+/// box of a triangle with that vertex alone ([`Projected::rows`]), or [`ALL_ROWS`] if
+/// a triangle with it needs clipping or is rejected.
+pub fn vertex_spans(projected: &[Projected], height: u32, spans: &mut Vec<u32>) {
+    let last = i64::from(height.max(1)) - 1;
+    spans.clear();
+    spans.extend(projected.iter().map(|p| match p.rows() {
+        Some([first, end]) => first.clamp(0, last) as u32 | (end.clamp(0, last) as u32) << 16,
+        None => ALL_ROWS,
+    }));
+}
+
 /// Where `strips` strips of a target `height` rows high end, each a multiple of 8
-/// rows but the last, so that each holds about as many of the `projected` vertices
-/// (`hist` is scratch); strips left without rows are dropped. Returns the ends and
-/// how many strips there are.
+/// rows but the last, so that each holds about as many vertices (by their first rows
+/// in `spans`, see [`vertex_spans`]; `hist` is scratch); strips left without rows are
+/// dropped. Returns the ends and how many strips there are.
 #[must_use]
 pub fn strip_ends(
-    projected: &[Projected],
+    spans: &[u32],
     height: u32,
     strips: usize,
     hist: &mut Vec<u32>,
@@ -166,10 +190,11 @@ pub fn strip_ends(
     let blocks = height.div_ceil(8) as usize;
     hist.clear();
     hist.resize(blocks, 0);
-    let last = i64::from(height.max(1)) - 1;
-    for p in projected {
-        if let Some(row) = p.row() {
-            hist[(row.clamp(0, last) / 8) as usize] += 1;
+    for &s in spans {
+        if s != ALL_ROWS
+            && let Some(h) = hist.get_mut((s & 0xffff) as usize / 8)
+        {
+            *h += 1;
         }
     }
     let total: u64 = hist.iter().map(|&c| u64::from(c)).sum();
@@ -222,13 +247,19 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
     );
     let store = &mut r.projected;
     let projected = pool.install(|| projections(cache, target, store));
+    let scratch = &mut r.scratch;
+    vertex_spans(projected, target.height, &mut scratch.spans);
     let (ends, count) = strip_ends(
-        projected,
+        &scratch.spans,
         target.height,
         pool.current_num_threads(),
-        &mut r.scratch.rows,
+        &mut scratch.rows,
     );
     let ends = &ends[..count];
+    let plan = StripPlan {
+        ends,
+        spans: &scratch.spans,
+    };
     let clear = r.pending_clear.take();
     let job = Job {
         shader,
@@ -274,7 +305,7 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
                 }
                 let start = Instant::now();
                 // SAFETY: the caller's guarantee.
-                let stats = unsafe { T::strip(&job, ends, i, c, d, clear) };
+                let stats = unsafe { T::strip(&job, &plan, i, c, d, clear) };
                 if i > 0 {
                     done.fetch_add(1, Ordering::Release);
                 } else {
@@ -299,11 +330,14 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
 #[cfg(test)]
 mod tests {
     use glam::Vec4;
+    use proptest::prelude::*;
 
-    use super::{MAX_STRIPS, strip_ends};
+    use super::{ALL_ROWS, MAX_STRIPS, strip_ends, vertex_spans};
     use crate::raster::Target;
-    use crate::raster::clip::guard_band_ndc;
+    use crate::raster::clip::{ClipVertex, guard_band_ndc};
     use crate::render::Projected;
+    use crate::render::options::Cull;
+    use crate::render::prepare::{PrepareOutcome, Prepared, VertexCache, prepare_projected};
 
     /// Each strip ends at the first 8-row block by which the strips so far hold their
     /// share of the vertices; vertices off the target count at its nearest row, and
@@ -325,17 +359,75 @@ mod tests {
         pv.extend((0..20).map(|_| at_row(239.5)));
         let behind = Projected::of(Vec4::new(0.0, 0.0, 0.5, -1.0), target, guard);
         pv.extend((0..50).map(|_| behind));
-        let mut hist = Vec::new();
+        let (mut hist, mut spans) = (Vec::new(), Vec::new());
+        vertex_spans(&pv, 240, &mut spans);
         // Halves: 20 of 70 by row 8, 50 by row 208.
-        assert_eq!(strip_ends(&pv, 240, 2, &mut hist).0[..2], [208, 240]);
+        assert_eq!(strip_ends(&spans, 240, 2, &mut hist).0[..2], [208, 240]);
         // Quarters: 17.5 by row 8 (20), 35 by row 208, 52.5 by row 240.
-        let (ends, count) = strip_ends(&pv, 240, 4, &mut hist);
+        let (ends, count) = strip_ends(&spans, 240, 4, &mut hist);
         assert_eq!(&ends[..count], &[8, 208, 240]);
         // Nothing to count: equal heights.
-        assert_eq!(
-            strip_ends(&[behind], 240, 3, &mut hist).0[..3],
-            [80, 160, 240]
-        );
+        vertex_spans(&[behind], 240, &mut spans);
+        assert_eq!(spans, [ALL_ROWS]);
+        assert_eq!(strip_ends(&spans, 240, 3, &mut hist).0[..3], [80, 160, 240]);
+    }
+
+    /// A clip coordinate: mostly within the frustum, some outside it, behind the eye,
+    /// beyond the guard band, or not finite.
+    fn coord() -> impl Strategy<Value = f32> {
+        prop_oneof![
+            6 => -1.2f32..1.2,
+            1 => -40.0f32..40.0,
+            1 => prop::sample::select(vec![0.0, -0.0, 1.0, -1.0, 1e9, -1e9, f32::NAN]),
+        ]
+    }
+
+    proptest! {
+        /// The rows the scan takes from a triangle's vertex spans are the rows of the
+        /// box its set-up makes, and a triangle that needs clipping (or is rejected
+        /// for its vertices) has a vertex spanning every row.
+        #[test]
+        fn spans_give_the_set_up_box_rows(
+            pos in prop::collection::vec((coord(), coord(), 0.1f32..0.9, 0.5f32..2.0), 3),
+            w_sign in prop::collection::vec(prop::bool::weighted(0.1), 3),
+            (w, h) in (1u32..300, 1u32..300),
+        ) {
+            let target = Target::new(w, h);
+            let guard = guard_band_ndc(w, h);
+            let verts: Vec<ClipVertex<()>> = pos
+                .iter()
+                .zip(&w_sign)
+                .map(|(&(x, y, z, w), &behind)| {
+                    let w = if behind { -w } else { w };
+                    ClipVertex { pos: Vec4::new(x * w, y * w, z * w, w), var: () }
+                })
+                .collect();
+            let pv: Vec<Projected> = verts.iter().map(|v| Projected::of(v.pos, target, guard)).collect();
+            let mut spans = Vec::new();
+            vertex_spans(&pv, h, &mut spans);
+            let cache = VertexCache { verts, projected: pv.clone(), projected_for: Some(target) };
+            let mut boxes = Vec::new();
+            let outcome = prepare_projected(
+                &cache, Some(&pv), &[0, 1, 2], 0, target, Cull::None,
+                &mut |p: &Prepared<()>| boxes.push(p.setup.bbox),
+            );
+            if spans.contains(&ALL_ROWS) {
+                let clipped = matches!(
+                    outcome,
+                    PrepareOutcome::Rejected | PrepareOutcome::Drawn { clipped: true }
+                );
+                prop_assert!(clipped);
+            } else {
+                let unclipped = !matches!(outcome, PrepareOutcome::Drawn { clipped: true });
+                prop_assert!(unclipped);
+                let top = spans.iter().map(|s| s & 0xffff).min().unwrap();
+                let bottom = spans.iter().map(|s| s >> 16).max().unwrap();
+                prop_assert!(boxes.len() <= 1);
+                for b in boxes {
+                    prop_assert_eq!([b.y0, b.y1], [top, bottom]);
+                }
+            }
+        }
     }
 
     /// Strips cover the target in order, end on multiples of 8 rows (but the last),

@@ -75,11 +75,19 @@ impl<V, W: StripWalk<V>> EmitPiece<V> for Cut<'_, W> {
     fn piece(&mut self, p: &Prepared<V>) {
         let b = p.setup.bbox;
         let [y0, y1] = self.rows;
-        if b.y0 >= y0 && b.y1 <= y1 {
-            self.walker.walk_setup(p, &p.setup);
-        } else if let Some(s) = p.setup.rows(y0, y1) {
-            self.walker.walk_setup(p, &s);
-        }
+        let cut: Setup;
+        // One call of the walk (it is inlined, so two would be two copies of it): a box
+        // within the strip is walked as it is, one across its edge as its rows there.
+        let setup = if b.y0 >= y0 && b.y1 <= y1 {
+            &p.setup
+        } else {
+            let Some(s) = p.setup.rows(y0, y1) else {
+                return;
+            };
+            cut = s;
+            &cut
+        };
+        self.walker.walk_setup(p, setup);
     }
 }
 
@@ -135,8 +143,10 @@ pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L
         // The box's first row (clamped to the target) is in its owner's strip.
         let top = (a & 0xffff).min(b & 0xffff).min(c & 0xffff);
         let bottom = (a >> 16).max(b >> 16).max(c >> 16);
-        let owner = (y0..=y1).contains(&top);
-        if !owner && (bottom < y0 || top > y1) {
+        // 1 for the owner, added to its counters without a branch: a branch on it after
+        // the set-up made the compiler copy the whole set-up and walk for each side.
+        let owner = u64::from((y0..=y1).contains(&top));
+        if owner == 0 && (bottom < y0 || top > y1) {
             continue;
         }
         let mut cut = Cut {
@@ -145,15 +155,13 @@ pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L
         };
         let (cache, target, cull) = (job.cache, job.target, job.opts.cull);
         let outcome = prepare_projected(cache, Some(projected), indices, t, target, cull, &mut cut);
-        if owner {
-            stats.triangles += 1;
-            match outcome {
-                PrepareOutcome::Rejected => stats.rejected += 1,
-                PrepareOutcome::Culled => stats.culled += 1,
-                PrepareOutcome::Drawn { clipped } => {
-                    stats.drawn += 1;
-                    stats.clipped += u64::from(clipped);
-                }
+        stats.triangles += owner;
+        match outcome {
+            PrepareOutcome::Rejected => stats.rejected += owner,
+            PrepareOutcome::Culled => stats.culled += owner,
+            PrepareOutcome::Drawn { clipped } => {
+                stats.drawn += owner;
+                stats.clipped += owner & u64::from(clipped);
             }
         }
     }

@@ -237,8 +237,28 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore> EmitPiec
 impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore>
     PieceWalker<'_, S, C, L, V, D>
 {
+    /// Walks the part of `tri` in rows `y0..=y1` (a band's or a strip's): its own box if
+    /// within them, else its box cut to them ([`Setup::rows`], the same edge values at
+    /// every pixel). One call of the walk either way: it is inlined, so a second call
+    /// would be a second copy of the traversal and fragment loop.
+    #[inline(always)]
+    pub(super) fn walk_rows(&mut self, tri: &Prepared<S::Varying>, y0: u32, y1: u32) {
+        let b = tri.setup.bbox;
+        let cut: Setup;
+        let setup = if b.y0 >= y0 && b.y1 <= y1 {
+            &tri.setup
+        } else {
+            let Some(s) = tri.setup.rows(y0, y1) else {
+                return;
+            };
+            cut = s;
+            &cut
+        };
+        self.walk(tri, setup);
+    }
+
     /// Walks `setup`'s box of triangle `tri`: its own ([`EmitPiece::piece`]), or the
-    /// part in a band of rows ([`Setup::rows`], the same edge values at every pixel).
+    /// part in a band of rows ([`PieceWalker::walk_rows`]).
     #[inline(always)]
     pub(super) fn walk(&mut self, tri: &Prepared<S::Varying>, setup: &Setup) {
         let (depth_state, _) = V::state(&self.opts);

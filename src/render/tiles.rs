@@ -15,9 +15,10 @@
 //! 3. **Walk**: each band is walked by one thread, which takes the bins of every
 //!    chunk in chunk order: the triangles of a band reach its depth test and its
 //!    colour writes in draw order, as on one thread. A triangle that crosses bands is
-//!    walked in each with its box cut to the band's rows ([`Setup::rows`], the same
-//!    edge values at every pixel), so every pixel gets the same fragments, in the same
-//!    order, through the same copy of the draw loop ([`super::DrawCopy::choose`]).
+//!    walked in each with its box cut to the band's rows
+//!    ([`Setup::rows`](crate::raster::Setup::rows), the same edge values at every
+//!    pixel), so every pixel gets the same fragments, in the same order, through the
+//!    same copy of the draw loop ([`super::DrawCopy::choose`]).
 //!    Which thread walks which band, and when, is up to `queue`: costliest first
 //!    within each thread's run of bands, so that the threads finish together. The
 //!    records were written by whichever core set them up, so the walk asks for the
@@ -46,8 +47,8 @@ use super::prepare::{Projected, VertexCache};
 use super::shader::Shader;
 use super::target::ColorTarget;
 use super::{Renderer, Spread};
+use crate::raster::Target;
 use crate::raster::depth::DepthRows;
-use crate::raster::{Setup, Target};
 use crate::simd::{I32s, prefetch};
 use queue::plan_bands;
 use strips::StripPlan;
@@ -361,21 +362,7 @@ pub(super) fn walk_band<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
             if let Some(&next) = bin.get(k + 1) {
                 prefetch(&chunk.records[next as usize]);
             }
-            let tri = &chunk.records[i as usize];
-            let b = tri.setup.bbox;
-            let cut: Setup;
-            // One call of the walk (it is inlined): a box within the band is walked as
-            // it is, one across its edge as its rows in the band.
-            let setup = if b.y0 >= y0 && b.y1 <= y1 {
-                &tri.setup
-            } else {
-                let Some(s) = tri.setup.rows(y0, y1) else {
-                    continue;
-                };
-                cut = s;
-                &cut
-            };
-            walker.walk(tri, setup);
+            walker.walk_rows(&chunk.records[i as usize], y0, y1);
         }
     }
     walker.stats

@@ -103,7 +103,7 @@ fn covers_any(s: &Setup) -> bool {
 }
 
 /// Sets up triangles `range` of the draw into `chunk`, counting them as one thread
-/// does: the body of every copy's [`TileCopy::setup`].
+/// does: the body of every copy's [`super::TileCopy::setup`].
 #[inline(always)]
 pub(in crate::render) fn setup_chunk<S: Shader>(
     job: &Job<'_, S>,

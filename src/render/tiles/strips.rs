@@ -6,11 +6,12 @@
 //! then costs more than the second thread saves, as its set-up records go through
 //! memory between two parallel steps. Here there is one step: each thread scans the
 //! triangles in draw order, skips those whose box misses its strip, and sets up and
-//! walks the others with their boxes cut to its rows ([`Setup::rows`]), as one thread
-//! would. Only triangles crossing a strip's border are set up twice. The scan reads
-//! one word per vertex, the rows a box takes from it ([`vertex_spans`]), made once
-//! before the strips start: the box's rows run from the least first row of its
-//! vertices to the greatest last row.
+//! walks the others with their boxes cut to its rows
+//! ([`Setup::rows`](crate::raster::Setup::rows)), as one thread would. Only triangles
+//! crossing a strip's border are set up twice. The scan reads one word per vertex,
+//! the rows a box takes from it ([`vertex_spans`]), made once before the strips
+//! start: the box's rows run from the least first row of its vertices to the
+//! greatest last row.
 //!
 //! The strips hold about as many vertices each (counted per 8 rows before the draw),
 //! so the threads finish together. The strips are worth it only to a caller that runs
@@ -30,7 +31,6 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::{Job, TileCopy, projections};
-use crate::raster::Setup;
 use crate::raster::depth::DepthRows;
 use crate::render::fragments::PieceWalker;
 use crate::render::isa::DrawVariant;
@@ -73,35 +73,22 @@ struct Cut<'w, W> {
 impl<V, W: StripWalk<V>> EmitPiece<V> for Cut<'_, W> {
     #[inline(always)]
     fn piece(&mut self, p: &Prepared<V>) {
-        let b = p.setup.bbox;
         let [y0, y1] = self.rows;
-        let cut: Setup;
-        // One call of the walk (it is inlined, so two would be two copies of it): a box
-        // within the strip is walked as it is, one across its edge as its rows there.
-        let setup = if b.y0 >= y0 && b.y1 <= y1 {
-            &p.setup
-        } else {
-            let Some(s) = p.setup.rows(y0, y1) else {
-                return;
-            };
-            cut = s;
-            &cut
-        };
-        self.walker.walk_setup(p, setup);
+        self.walker.walk_rows(p, y0, y1);
     }
 }
 
-/// [`PieceWalker::walk`], named so [`Cut`] needs no type parameters of its own.
+/// [`PieceWalker::walk_rows`], named so [`Cut`] needs no type parameters of its own.
 trait StripWalk<V> {
-    fn walk_setup(&mut self, p: &Prepared<V>, s: &Setup);
+    fn walk_rows(&mut self, p: &Prepared<V>, y0: u32, y1: u32);
 }
 
 impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> StripWalk<S::Varying>
     for PieceWalker<'_, S, C, L, V, DepthRows<'_>>
 {
     #[inline(always)]
-    fn walk_setup(&mut self, p: &Prepared<S::Varying>, s: &Setup) {
-        self.walk(p, s);
+    fn walk_rows(&mut self, p: &Prepared<S::Varying>, y0: u32, y1: u32) {
+        PieceWalker::walk_rows(self, p, y0, y1);
     }
 }
 
@@ -172,7 +159,7 @@ pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L
 
 /// Fills `spans` with one word per vertex of `projected` for a target `height` rows
 /// high: `first | last << 16`, the first and last row (clamped to the target) of the
-/// box of a triangle with that vertex alone ([`Projected::rows`]), or [`ALL_ROWS`] if
+/// box of a triangle with that vertex alone (`Projected::rows`), or [`ALL_ROWS`] if
 /// a triangle with it needs clipping or is rejected.
 pub fn vertex_spans(projected: &[Projected], height: u32, spans: &mut Vec<u32>) {
     let last = i64::from(height.max(1)) - 1;

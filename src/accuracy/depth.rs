@@ -12,7 +12,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use crate::raster::traverse::wide;
 use crate::raster::{CoverageSink, Target};
-use crate::render::{Cull, EmitPiece, Prepared, Shader, VertexCache, prepare, transform};
+use crate::render::{DrawOptions, EmitPiece, Prepared, Shader, VertexCache, prepare, transform};
 
 /// One depth storage format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -198,7 +198,14 @@ impl DepthPass {
         };
         let cache = std::mem::take(&mut self.cache);
         for t in 0..(indices.len() / 3) as u32 {
-            prepare(&cache, indices, t, self.target, Cull::None, &mut sink);
+            prepare(
+                &cache,
+                indices,
+                t,
+                self.target,
+                &DrawOptions::default(),
+                &mut sink,
+            );
         }
         self.fragments += sink.fragments;
         self.cache = cache;

@@ -12,7 +12,7 @@ use glam::{DMat4, DVec3, DVec4, Mat4, Vec2, Vec3, Vec4};
 use crate::camera::Camera;
 use crate::mesh::Mesh;
 use crate::raster::Target;
-use crate::render::{Cull, Prepared, Shader, VertexCache, prepare, transform};
+use crate::render::{DrawOptions, Prepared, Shader, VertexCache, prepare, transform};
 use crate::workload::{Tri2, sliver_fan, tiling, tiny_triangles};
 
 /// Names of the workloads, in table order.
@@ -223,7 +223,7 @@ pub fn projected(scene: &Scene3, target: Target) -> Vec<Tri2> {
             &scene.indices,
             t,
             target,
-            Cull::None,
+            &DrawOptions::default(),
             &mut |p: &Prepared<Vec2>| {
                 out.push(p.screen.map(|v| [f64::from(v[0]), f64::from(v[1])]));
             },
@@ -293,7 +293,7 @@ mod tests {
                         &near.indices,
                         t,
                         target,
-                        Cull::None,
+                        &DrawOptions::default(),
                         &mut |_: &Prepared<Vec2>| {}
                     ),
                     crate::render::PrepareOutcome::Drawn { clipped: true }

@@ -15,19 +15,20 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use crate::simd::each3;
+
 /// A set of per-vertex attributes interpolated across a triangle. `Send + Sync`
 /// and `'static`: a threaded draw's threads share and keep the per-triangle records.
 pub trait Varying: Copy + Send + Sync + 'static {
-    /// Whether only the value's direction matters to the shader that reads it (a
-    /// normal it normalises per pixel): the value times any positive factor shades
-    /// the same. Under perspective such a varying is interpolated as `attribute/w`
-    /// itself, the numerator `Σ vᵢ·bᵢ/wᵢ` of the perspective-correct form, without its
-    /// division by the
-    /// interpolated `1/w`: as `Σ (vᵢ·cᵢ)·Fᵢ` for the exact edge values `Fᵢ`, with
-    /// `cᵢ = (1/wᵢ)/area2` folded into the vertex values once per triangle
-    /// ([`Varying::projective_form`]). That saves a division and a multiply per
-    /// vertex per pixel. In the other modes it is a weighted sum of the vertex values
-    /// (its relative form is `[a, b, c]`: see [`Direction`]).
+    /// Whether the shader that reads the value divides it itself: it needs only its
+    /// direction (a normal it normalises per pixel), or it carries its own weight
+    /// ([`Homogeneous`]). Under perspective such a varying is interpolated as
+    /// `attribute/w` itself, the numerator `Σ vᵢ·bᵢ/wᵢ` of the perspective-correct
+    /// form, without the division by the interpolated `1/w`: as `Σ (vᵢ·cᵢ)·Fᵢ` for the
+    /// exact edge values `Fᵢ`, with `cᵢ = (1/wᵢ)/area2` folded into the vertex values
+    /// once per triangle ([`Varying::projective_form`]). That saves a division and a
+    /// multiply per vertex per pixel. In the other modes it is a weighted sum of the
+    /// vertex values (its relative form is `[a, b, c]`: see [`Direction`]).
     const PROJECTIVE: bool = false;
 
     /// The interpolated value for weights `w` (summing to 1), computed relative to `a`
@@ -43,9 +44,9 @@ pub trait Varying: Copy + Send + Sync + 'static {
     /// `[a, b, c]`.)
     fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3];
 
-    /// The per-triangle form of a [`Varying::PROJECTIVE`] varying under perspective:
-    /// the vertex values `v` times `c` (see there). Other varyings never read it, and
-    /// keep the vertex values.
+    /// The per-triangle form of a [`Varying::PROJECTIVE`] varying under perspective,
+    /// in place of [`Varying::relative`]: the vertex values `v` times `c` (see there).
+    /// Other varyings are never asked for it.
     #[must_use]
     fn projective_form(v: &[Self; 3], c: [f32; 3]) -> [Self; 3] {
         let _ = c;
@@ -123,24 +124,62 @@ impl Varying for Direction {
     }
     #[inline(always)]
     fn projective_form(v: &[Self; 3], c: [f32; 3]) -> [Self; 3] {
-        [
-            Self(v[0].0 * c[0]),
-            Self(v[1].0 * c[1]),
-            Self(v[2].0 * c[2]),
-        ]
+        each3!(|i| Self(v[i].0 * c[i]))
     }
     #[inline(always)]
     fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
         // Fused, inner first, from `a·w[0]` (Lambert's lane code repeats this).
-        let a = r[0].0 * w[0];
-        Self(
-            r[2].0
-                .mul_add(Vec3::splat(w[2]), r[1].0.mul_add(Vec3::splat(w[1]), a)),
-        )
+        let [a, b, c] = each3!(|i| r[i].0);
+        Self(c.mul_add(Vec3::splat(w[2]), b.mul_add(Vec3::splat(w[1]), a * w[0])))
     }
     #[inline(always)]
     fn lerp(a: &Self, b: &Self, t: f32) -> Self {
         Self(<Vec3 as Varying>::lerp(&a.0, &b.0, t))
+    }
+}
+
+/// A value carried with its own weight, `(value, 1)` at the vertices, for a shader
+/// that divides by the weight itself and can share that division with one of its
+/// own (the coloured Lambert's normalisation): a [`Varying::PROJECTIVE`] varying.
+/// Under perspective a pixel gets `Σ (vᵢ, 1)·bᵢ/wᵢ`, a positive multiple of the
+/// perspective-correct `(value, 1)`; in the other modes the weights sum to 1, and so
+/// does the weight up to rounding. [`Homogeneous::value`] divides.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Homogeneous(pub Vec4);
+
+impl Homogeneous {
+    /// `(v, 1)`: a vertex's value.
+    #[must_use]
+    pub fn new(v: Vec3) -> Self {
+        Self(v.extend(1.0))
+    }
+
+    /// The value: the first three components over the weight.
+    #[must_use]
+    pub fn value(self) -> Vec3 {
+        self.0.truncate() / self.0.w
+    }
+}
+
+impl Varying for Homogeneous {
+    const PROJECTIVE: bool = true;
+    #[inline(always)]
+    fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3] {
+        [*a, *b, *c]
+    }
+    #[inline(always)]
+    fn projective_form(v: &[Self; 3], c: [f32; 3]) -> [Self; 3] {
+        each3!(|i| Self(v[i].0 * c[i]))
+    }
+    #[inline(always)]
+    fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
+        // As `Direction`'s, per component (the coloured Lambert's lane code repeats it).
+        let [a, b, c] = each3!(|i| r[i].0);
+        Self(c.mul_add(Vec4::splat(w[2]), b.mul_add(Vec4::splat(w[1]), a * w[0])))
+    }
+    #[inline(always)]
+    fn lerp(a: &Self, b: &Self, t: f32) -> Self {
+        Self(<Vec4 as Varying>::lerp(&a.0, &b.0, t))
     }
 }
 
@@ -177,7 +216,16 @@ impl<const K: usize> Varying for [f32; K] {
     }
 }
 
+/// Projective when both parts are; otherwise both take weights that sum to 1, which
+/// a projective part shades the same with.
 impl<A: Varying, B: Varying> Varying for (A, B) {
+    const PROJECTIVE: bool = A::PROJECTIVE && B::PROJECTIVE;
+    #[inline(always)]
+    fn projective_form(v: &[Self; 3], c: [f32; 3]) -> [Self; 3] {
+        let a = A::projective_form(&each3!(|i| v[i].0), c);
+        let b = B::projective_form(&each3!(|i| v[i].1), c);
+        each3!(|i| (a[i], b[i]))
+    }
     #[inline(always)]
     fn relative(a: &Self, b: &Self, c: &Self) -> [Self; 3] {
         let [a0, a1, a2] = A::relative(&a.0, &b.0, &c.0);

@@ -175,7 +175,7 @@ impl<V: Varying> Prepared<V> {
     }
 
     /// The interpolation weights of A, B, C at an evaluated pixel in `mode`, summing
-    /// to 1. ([`Prepared::varyings`] weighs a projective varying's `projective` form by
+    /// to 1. ([`Prepared::varyings`] weighs a projective varying's projective form by
     /// the edge values instead under perspective.)
     #[inline(always)]
     #[must_use]
@@ -195,7 +195,7 @@ impl<V: Varying> Prepared<V> {
     #[must_use]
     pub fn varyings(&self, e: &PixelEval, mode: Interpolation) -> V {
         if V::PROJECTIVE && mode == Interpolation::Perspective {
-            V::from_relative(&self.projective, self.vertex_edges(e.f))
+            V::from_relative(&self.rel, self.vertex_edges(e.f))
         } else {
             V::from_relative(&self.rel, self.weights(e, mode))
         }
@@ -214,7 +214,7 @@ impl<V: Varying> Prepared<V> {
     ) -> (&[V; 3], [F; 3]) {
         match mode {
             // Projective varyings take the edge values themselves as weights.
-            Interpolation::Perspective if V::PROJECTIVE => (&self.projective, q),
+            Interpolation::Perspective if V::PROJECTIVE => (&self.rel, q),
             Interpolation::Perspective => (&self.rel, perspective_weights_lanes(q, self.pc)),
             Interpolation::Affine => {
                 let ia = F::splat(self.inv_area2);

@@ -432,7 +432,7 @@ impl Renderer {
         for t in 0..n {
             walker.stats.triangles += 1;
             let pv = Some(pv);
-            match prepare_projected(cache, pv, indices, t, target, opts.cull, &mut walker) {
+            match prepare_projected(cache, pv, indices, t, target, opts, &mut walker) {
                 PrepareOutcome::Rejected => walker.stats.rejected += 1,
                 PrepareOutcome::Culled => walker.stats.culled += 1,
                 PrepareOutcome::Drawn { clipped } => {

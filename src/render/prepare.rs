@@ -7,12 +7,12 @@ use std::ops::{Add, Mul, Sub};
 
 use glam::Vec4;
 
-use super::options::Cull;
+use super::options::{Cull, DrawOptions};
 use super::shader::Shader;
 use crate::raster::clip::{
     ClipOutcome, ClipVertex, classify_codes, clip_straddling, guard_band_ndc, outcode,
 };
-use crate::raster::interp::Varying;
+use crate::raster::interp::{Interpolation, Varying};
 use crate::raster::setup::{box_holds, box_rows, snap};
 use crate::raster::{SUBPIXEL_BITS, Setup, Target};
 use crate::simd::each3;
@@ -37,12 +37,12 @@ pub struct Prepared<V> {
     pub z: [f32; 3],
     /// 1/w of each vertex.
     pub inv_w: [f32; 3],
-    /// The varyings in relative form (see [`Varying::relative`]).
+    /// The varyings in the form the draw's interpolation mode reads: relative (see
+    /// [`Varying::relative`]), or for a [`Varying::PROJECTIVE`] varying under
+    /// perspective the vertex values times `pc` ([`Varying::projective_form`]),
+    /// weighted by the edge values. So a record is read in the mode it was prepared
+    /// for.
     pub rel: [V; 3],
-    /// For [`Varying::PROJECTIVE`] varyings, the vertex values times `pc`
-    /// ([`Varying::projective_form`]), interpolated with the edge values as weights
-    /// under perspective. Otherwise the vertex values, never read.
-    pub projective: [V; 3],
     /// `1 / area2`, rounded once to f32: barycentrics are `F · inv_area2`.
     pub inv_area2: f32,
     /// Depth per unit of B's and C's edge value: `(z_B − z_A) / area2` and
@@ -245,10 +245,10 @@ pub fn prepare<V: Varying>(
     indices: &[u32],
     t: u32,
     target: Target,
-    cull: Cull,
+    opts: &DrawOptions,
     emit: &mut impl EmitPiece<V>,
 ) -> PrepareOutcome {
-    prepare_projected(cache, None, indices, t, target, cull, emit)
+    prepare_projected(cache, None, indices, t, target, opts, emit)
 }
 
 /// [`prepare`] with the vertices' projections from [`project_vertices`] (for this
@@ -260,7 +260,7 @@ pub fn prepare_projected<V: Varying>(
     indices: &[u32],
     t: u32,
     target: Target,
-    cull: Cull,
+    opts: &DrawOptions,
     emit: &mut impl EmitPiece<V>,
 ) -> PrepareOutcome {
     let base = t as usize * 3;
@@ -291,7 +291,7 @@ pub fn prepare_projected<V: Varying>(
         ClipOutcome::Rejected => return PrepareOutcome::Rejected,
         ClipOutcome::Inside => {
             let var = each3!(|i| tri[i].var);
-            seen.add(setup_piece((t, 0, clipped), pv, var, target, cull, emit));
+            seen.add(setup_piece((t, 0, clipped), pv, var, target, opts, emit));
         }
         ClipOutcome::Clipped => {
             let Some(poly) = clip_straddling(tri, guard) else {
@@ -300,7 +300,7 @@ pub fn prepare_projected<V: Varying>(
             for (i, tri) in poly.triangles().enumerate() {
                 let pv = each3!(|i| Projected::of(tri[i].pos, target, guard));
                 let var = each3!(|i| tri[i].var);
-                seen.add(setup_piece((t, i, clipped), pv, var, target, cull, emit));
+                seen.add(setup_piece((t, i, clipped), pv, var, target, opts, emit));
             }
         }
     }
@@ -347,7 +347,7 @@ fn setup_piece<V: Varying>(
     pv: [Projected; 3],
     var: [V; 3],
     target: Target,
-    cull: Cull,
+    opts: &DrawOptions,
     emit: &mut impl EmitPiece<V>,
 ) -> Piece {
     // Not `iter().all(..)`: it stays out of line in the AVX2 draw loop.
@@ -358,7 +358,7 @@ fn setup_piece<V: Varying>(
         return Piece::Rejected;
     };
     // Counter-clockwise in NDC (y-up) is negative area in y-down screen space.
-    if cull == Cull::Back && !setup.flipped {
+    if opts.cull == Cull::Back && !setup.flipped {
         return Piece::Culled;
     }
     let order = |i: usize| if setup.flipped && i > 0 { 3 - i } else { i };
@@ -373,7 +373,12 @@ fn setup_piece<V: Varying>(
     let slope = |i: usize| ((f64::from(z[i]) - f64::from(z[0])) * ia) as f32;
     let zc = [slope(1), slope(2)];
     let pc = each3!(|i| (f64::from(inv_w[i]) * ia) as f32);
-    let rel = V::relative(&var[0], &var[1], &var[2]);
+    // The one form of the varyings the draw's pixels read.
+    let rel = if V::PROJECTIVE && opts.interpolation == Interpolation::Perspective {
+        V::projective_form(&var, pc)
+    } else {
+        V::relative(&var[0], &var[1], &var[2])
+    };
     emit.piece(&Prepared {
         triangle: t,
         piece: piece as u8,
@@ -385,7 +390,6 @@ fn setup_piece<V: Varying>(
         zc,
         pc,
         rel,
-        projective: V::projective_form(&var, pc),
         inv_area2: ia as f32,
         edge_rem,
     });

@@ -143,7 +143,7 @@ pub fn probe_projected<V: Varying>(
             indices,
             t,
             target,
-            opts.cull,
+            opts,
             &mut |p: &Prepared<V>| {
                 let s = &p.setup;
                 if !s.bbox.contains(x, y) {

@@ -4,7 +4,7 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use super::{ShadeLanes, Shader};
 use crate::mesh::Mesh;
-use crate::raster::interp::Direction;
+use crate::raster::interp::{Direction, Homogeneous};
 use crate::simd::{F32s, each3};
 
 /// The standard light direction (towards the light, world space), normalised.
@@ -32,6 +32,9 @@ pub struct Lambert<'a> {
     lit: Vec3,
     /// Surface colour times the ambient term.
     unlit: Vec3,
+    /// The surface colour and the ambient term themselves ([`ColoredLambert`]).
+    base: Vec3,
+    ambient: f32,
     /// Whether the three channels of the surface colour are equal (see
     /// [`ShadeLanes::Grey`]).
     grey: bool,
@@ -48,6 +51,8 @@ impl<'a> Lambert<'a> {
             light: standard_light(),
             lit: Vec3::ONE,
             unlit: Vec3::ZERO,
+            base: Vec3::ONE,
+            ambient: 0.0,
             grey: true,
         }
         .with_material(Vec3::ONE, 0.08)
@@ -59,6 +64,8 @@ impl<'a> Lambert<'a> {
         Self {
             lit: base * (1.0 - ambient),
             unlit: base * ambient,
+            base,
+            ambient,
             grey: base.x == base.y && base.y == base.z,
             ..self
         }
@@ -116,11 +123,8 @@ impl Shader for Lambert<'_> {
         w: &[F; 3],
         _mask: u32,
     ) -> ShadeLanes<F> {
-        // `Direction::from_relative` lane by lane: a·w0 + b·w1 + c·w2, fused.
-        let [a, b, c] = [rel[0].0, rel[1].0, rel[2].0];
-        let n =
-            each3!(|i| F::splat(c[i])
-                .mul_add(w[2], F::splat(b[i]).mul_add(w[1], F::splat(a[i]) * w[0])));
+        let [Direction(a), Direction(b), Direction(c)] = *rel;
+        let n = each3!(|i| weigh_lanes([a[i], b[i], c[i]], w));
         let l = self.cosine_lanes(n);
         let (lit, unlit) = (self.lit, self.unlit);
         // A grey base (the standard scene's white) gives three equal channels: one
@@ -134,50 +138,117 @@ impl Shader for Lambert<'_> {
 }
 
 /// [`Lambert`] times the mesh's vertex colours (a scan's, a painted asset's):
-/// `colour·(l·lit + unlit)`, with lane code of its own. Varying: the world-space
-/// normal and the vertex colour, both perspective-correct (the colour needs the
-/// division, so the normal takes the same weights rather than its projective form).
+/// `colour·base·((1 − ambient)·l + ambient)` for the cosine `l`, with lane code of
+/// its own. Varying: the world-space normal as a [`Direction`] and the vertex colour
+/// times the surface colour as a [`Homogeneous`] value, both
+/// [`Varying::PROJECTIVE`](crate::raster::interp::Varying::PROJECTIVE): under
+/// perspective neither is divided by the interpolated `1/w` before the shader, which
+/// divides once, for the normal's length and the colour's weight together.
 #[derive(Clone, Debug)]
-pub struct ColoredLambert<'a>(pub Lambert<'a>);
+pub struct ColoredLambert<'a> {
+    lambert: Lambert<'a>,
+    /// Towards the light, times `1 − ambient`.
+    light: Vec3,
+}
+
+/// The least normal length [`ColoredLambert`] divides by: a zero normal (cosine 0)
+/// shades `colour·base·ambient`, as [`Lambert`]'s does, instead of `0/0`.
+const MIN_NORMAL_LENGTH: f32 = 1e-20;
+
+/// `x > y ? x : y`, the lanes' `max` (which returns `y` when either is NaN).
+#[inline(always)]
+fn max(x: f32, y: f32) -> f32 {
+    if x > y { x } else { y }
+}
+
+impl<'a> ColoredLambert<'a> {
+    /// `lambert` times the mesh's vertex colours (white where it has none).
+    #[must_use]
+    pub fn new(lambert: Lambert<'a>) -> Self {
+        let light = lambert.light * (1.0 - lambert.ambient);
+        Self { lambert, light }
+    }
+
+    /// The colour for an interpolated normal `n` and colour `h = (s·c, s)`, with one
+    /// division: `c·((1 − ambient)·max(n·L, 0)/|n| + ambient)` is `h·m` for
+    /// `m = (max(n·L′, 0) + ambient·|n|) / (|n|·s)`, `L′ = (1 − ambient)·L`.
+    /// Written out, with fused multiply-adds, so [`ColoredLambert::shade_lanes`]
+    /// repeats it bit for bit.
+    #[inline(always)]
+    fn shade(&self, n: Vec3, h: Vec4) -> Vec3 {
+        let lt = self.light;
+        let len2 = n.z.mul_add(n.z, n.y.mul_add(n.y, n.x * n.x));
+        let len = max(len2.sqrt(), MIN_NORMAL_LENGTH);
+        let d = n.z.mul_add(lt.z, n.y.mul_add(lt.y, n.x * lt.x));
+        let m = len.mul_add(self.lambert.ambient, max(d, 0.0)) * (1.0 / (len * h.w));
+        Vec3::new(h.x * m, h.y * m, h.z * m)
+    }
+
+    /// [`ColoredLambert::shade`] on lanes.
+    #[inline(always)]
+    fn shade_lanes<F: F32s>(&self, [x, y, z]: [F; 3], h: [F; 4]) -> [F; 3] {
+        let lt = self.light;
+        let len = z
+            .mul_add(z, y.mul_add(y, x * x))
+            .sqrt()
+            .max(F::splat(MIN_NORMAL_LENGTH));
+        let d = z.mul_add(
+            F::splat(lt.z),
+            y.mul_add(F::splat(lt.y), x * F::splat(lt.x)),
+        );
+        let ambient = F::splat(self.lambert.ambient);
+        let m = len.mul_add(ambient, d.max(F::splat(0.0))) * (F::splat(1.0) / (len * h[3]));
+        each3!(|i| h[i] * m)
+    }
+}
 
 impl Shader for ColoredLambert<'_> {
-    type Varying = (Vec3, Vec3);
+    type Varying = (Direction, Homogeneous);
     const LANE_CODE: bool = true;
 
     #[inline(always)]
-    fn vertex(&self, index: u32) -> (Vec4, (Vec3, Vec3)) {
-        let (pos, Direction(n)) = self.0.vertex(index);
-        let c = self.0.mesh.colors.get(index as usize).copied();
-        (pos, (n, c.unwrap_or(Vec3::ONE)))
+    fn vertex(&self, index: u32) -> (Vec4, (Direction, Homogeneous)) {
+        let l = &self.lambert;
+        let (pos, n) = l.vertex(index);
+        let c = l.mesh.colors.get(index as usize).copied();
+        (pos, (n, Homogeneous::new(c.unwrap_or(Vec3::ONE) * l.base)))
     }
 
     #[inline(always)]
-    fn fragment(&self, &(n, c): &(Vec3, Vec3)) -> Vec3 {
-        let s = &self.0;
-        Vec3::splat(s.cosine(n)).mul_add(s.lit, s.unlit) * c
+    fn fragment(&self, &(Direction(n), Homogeneous(h)): &(Direction, Homogeneous)) -> Vec3 {
+        self.shade(n, h)
     }
 
     #[inline(always)]
     fn fragment_lanes<F: F32s>(
         &self,
-        rel: &[(Vec3, Vec3); 3],
+        rel: &[(Direction, Homogeneous); 3],
         w: &[F; 3],
         _mask: u32,
     ) -> ShadeLanes<F> {
-        let n = relative_lanes([rel[0].0, rel[1].0, rel[2].0], w);
-        let c = relative_lanes([rel[0].1, rel[1].1, rel[2].1], w);
-        let s = &self.0;
-        let l = s.cosine_lanes(n);
-        ShadeLanes::Rgb(each3!(|i| l
-            .mul_add(F::splat(s.lit[i]), F::splat(s.unlit[i]))
-            * c[i]))
+        let [
+            (Direction(na), Homogeneous(ha)),
+            (Direction(nb), Homogeneous(hb)),
+            (Direction(nc), Homogeneous(hc)),
+        ] = *rel;
+        let n = each3!(|i| weigh_lanes([na[i], nb[i], nc[i]], w));
+        let h = [
+            weigh_lanes([ha.x, hb.x, hc.x], w),
+            weigh_lanes([ha.y, hb.y, hc.y], w),
+            weigh_lanes([ha.z, hb.z, hc.z], w),
+            weigh_lanes([ha.w, hb.w, hc.w], w),
+        ];
+        ShadeLanes::Rgb(self.shade_lanes(n, h))
     }
 }
 
-/// `Vec3::from_relative` on lanes: `r0 + r1·w1 + r2·w2`, fused, inner first.
+/// One component of a [`Varying::PROJECTIVE`](crate::raster::interp::Varying::PROJECTIVE)
+/// varying's weighted sum on lanes, from its vertex values `r`: `r[0]·w[0] + r[1]·w[1]
+/// + r[2]·w[2]`, fused, inner first, as its `from_relative` computes it. (A plain
+/// function: closures, as `array::from_fn` takes, stay outside the lane copies.)
 #[inline(always)]
-fn relative_lanes<F: F32s>(r: [Vec3; 3], w: &[F; 3]) -> [F; 3] {
-    each3!(|i| F::splat(r[2][i]).mul_add(w[2], F::splat(r[1][i]).mul_add(w[1], F::splat(r[0][i]))))
+fn weigh_lanes<F: F32s>(r: [f32; 3], w: &[F; 3]) -> F {
+    F::splat(r[2]).mul_add(w[2], F::splat(r[1]).mul_add(w[1], F::splat(r[0]) * w[0]))
 }
 
 #[cfg(test)]
@@ -188,7 +259,7 @@ mod tests {
 
     use super::{ColoredLambert, Lambert};
     use crate::mesh::Mesh;
-    use crate::raster::interp::{Direction, Varying};
+    use crate::raster::interp::{Direction, Homogeneous, Varying};
     use crate::render::perspective_weights;
     use crate::render::{ShadeLanes, Shader};
     use crate::simd::F32s;
@@ -260,10 +331,10 @@ mod tests {
         }
 
         /// The coloured Lambert's 8-lane fragments equal its per-pixel ones bit for
-        /// bit: the normal and the colour interpolated as `Vec3` varyings are, then lit.
+        /// bit, zero normals included.
         #[test]
         fn colored_lambert_lanes_equal_single_fragments(
-            normals in prop::array::uniform3(vec3()),
+            normals in prop::array::uniform3(prop_oneof![vec3(), Just(Vec3::ZERO)]),
             colors in prop::array::uniform3(prop::array::uniform3(0.0f32..1.0)),
             w in prop::array::uniform3(prop::array::uniform8(0.0f32..1.0)),
             base in vec3(),
@@ -271,26 +342,86 @@ mod tests {
             mask in 1..=255u8,
         ) {
             let mesh = Mesh::teapot();
-            let shader = ColoredLambert(
+            let shader = ColoredLambert::new(
                 Lambert::new(&mesh, Mat4::IDENTITY, Mat4::IDENTITY)
                     .with_material(base.abs(), ambient),
             );
-            let v = |i: usize| (normals[i], Vec3::from(colors[i]));
-            let rel = <(Vec3, Vec3)>::relative(&v(0), &v(1), &v(2));
+            let v = |i: usize| (Direction(normals[i]), Homogeneous::new(Vec3::from(colors[i])));
+            let rel = <(Direction, Homogeneous)>::relative(&v(0), &v(1), &v(2));
             let lanes = w.map(f32x8::from);
             let ShadeLanes::Rgb(rgb) = shader.fragment_lanes(&rel, &lanes, mask.into()) else {
                 panic!("a coloured shader shades three channels");
             };
             let rgb = rgb.map(F32s::to_array);
             for k in (0..8).filter(|k| mask >> k & 1 == 1) {
-                let one = shader.fragment(&<(Vec3, Vec3)>::from_relative(
+                let one = shader.fragment(&<(Direction, Homogeneous)>::from_relative(
                     &rel,
                     [w[0][k], w[1][k], w[2][k]],
                 ));
+                prop_assert!(one.is_finite(), "{one}");
                 for (c, lane) in one.to_array().iter().zip(rgb) {
                     prop_assert_eq!(c.to_bits(), lane[k].to_bits(), "lane {}", k);
                 }
             }
+        }
+
+        /// The coloured Lambert, given its normal and colour without the perspective
+        /// division, shades as the perspective-correct formula does (in f64), to
+        /// within a few units of rounding: `colour·base·((1 − a)·max(n·L/|n|, 0) + a)`.
+        #[test]
+        fn colored_lambert_shades_the_perspective_correct_colour(
+            n in prop::array::uniform3(normal()),
+            colors in prop::array::uniform3(prop::array::uniform3(0.0f32..1.0)),
+            q in (1.0f32..1e6, 0.0f32..1e6, 0.0f32..1e6),
+            c in prop::array::uniform3(1e-9f32..1e-3),
+            base in prop::array::uniform3(0.0f32..1.0),
+            ambient in 0.0f32..0.5,
+        ) {
+            let mesh = Mesh::teapot();
+            let base = Vec3::from(base);
+            let shader = ColoredLambert::new(
+                Lambert::new(&mesh, Mat4::IDENTITY, Mat4::IDENTITY)
+                    .with_material(base, ambient),
+            );
+            let q = [q.0, q.1, q.2];
+            let verts = [0, 1, 2].map(|i| (Direction(n[i]), Homogeneous::new(Vec3::from(colors[i]) * base)));
+            let proj = <(Direction, Homogeneous)>::projective_form(&verts, c);
+            let fast = shader.fragment(&<(Direction, Homogeneous)>::from_relative(&proj, q));
+            // The oracle: perspective weights and the formula, in f64.
+            let p: [f64; 3] = std::array::from_fn(|i| f64::from(q[i]) * f64::from(c[i]));
+            let sum: f64 = p.iter().sum();
+            let mix = |v: [[f32; 3]; 3], k: usize| (0..3).map(|i| f64::from(v[i][k]) * p[i] / sum).sum::<f64>();
+            let nn: [f64; 3] = std::array::from_fn(|k| mix(n.map(|v| v.to_array()), k));
+            let len = nn.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let light = super::standard_light();
+            let d = nn[0] * f64::from(light.x) + nn[1] * f64::from(light.y) + nn[2] * f64::from(light.z);
+            let lit = (1.0 - f64::from(ambient)) * (d / len).max(0.0) + f64::from(ambient);
+            for k in 0..3 {
+                let exact = mix(colors, k) * f64::from(base[k]) * lit;
+                let err = (exact - f64::from(fast[k])).abs();
+                prop_assert!(err <= 4e-6, "channel {k}: {exact} against {}", fast[k]);
+            }
+        }
+    }
+
+    /// A zero normal (a degenerate mesh's) shades the ambient part of the colour, as
+    /// [`Lambert`] does, rather than NaN.
+    #[test]
+    fn colored_lambert_shades_a_zero_normal_with_the_ambient_term() {
+        let mesh = Mesh::teapot();
+        let base = Vec3::new(0.5, 1.0, 0.25);
+        let shader = ColoredLambert::new(
+            Lambert::new(&mesh, Mat4::IDENTITY, Mat4::IDENTITY).with_material(base, 0.2),
+        );
+        let colour = Vec3::new(0.8, 0.4, 1.0);
+        for s in [1e-3, 0.4, 1.0, 7.0] {
+            let h = Homogeneous((colour * base * s).extend(s));
+            let got = shader.fragment(&(Direction(Vec3::ZERO), h));
+            let want = colour * base * 0.2;
+            assert!(
+                (got - want).abs().max_element() <= 1e-6,
+                "{got} against {want} (s = {s})"
+            );
         }
     }
 }

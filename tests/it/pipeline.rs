@@ -12,7 +12,7 @@ use termrast::raster::{Target, Traversal};
 use termrast::render::probe::{DepthOutcome, probe};
 use termrast::render::shaders::Lambert;
 use termrast::render::target::to_u8;
-use termrast::render::{Cull, DrawOptions, Isa, Renderer, Shader, VertexCache, transform};
+use termrast::render::{DrawOptions, Isa, Renderer, Shader, VertexCache, transform};
 use termrast::scene::Scene;
 use termrast::scene::render::{SceneFrame, SceneView};
 
@@ -404,7 +404,7 @@ fn huge_triangles_take_the_i64_lanes_and_agree() {
         &[0, 1, 2],
         0,
         target,
-        Cull::None,
+        &DrawOptions::default(),
         &mut |p: &termrast::render::Prepared<Vec3>| {
             seen = Some(termrast::raster::traverse::fits_i32(&p.setup));
         },

@@ -130,8 +130,8 @@ pub(in crate::render) fn setup_chunk<S: Shader>(
     let pv = Some(job.projected);
     for t in range {
         stats.triangles += 1;
-        let (cache, indices, target, cull) = (job.cache, job.indices, job.target, job.opts.cull);
-        match prepare_projected(cache, pv, indices, t, target, cull, &mut binner) {
+        let (cache, indices, target) = (job.cache, job.indices, job.target);
+        match prepare_projected(cache, pv, indices, t, target, &job.opts, &mut binner) {
             PrepareOutcome::Rejected => stats.rejected += 1,
             PrepareOutcome::Culled => stats.culled += 1,
             PrepareOutcome::Drawn { clipped } => {

@@ -140,8 +140,16 @@ pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L
             walker: &mut walker,
             rows: [y0, y1],
         };
-        let (cache, target, cull) = (job.cache, job.target, job.opts.cull);
-        let outcome = prepare_projected(cache, Some(projected), indices, t, target, cull, &mut cut);
+        let (cache, target) = (job.cache, job.target);
+        let outcome = prepare_projected(
+            cache,
+            Some(projected),
+            indices,
+            t,
+            target,
+            &job.opts,
+            &mut cut,
+        );
         stats.triangles += owner;
         match outcome {
             PrepareOutcome::Rejected => stats.rejected += owner,
@@ -331,7 +339,7 @@ mod tests {
     use crate::raster::Target;
     use crate::raster::clip::{ClipVertex, guard_band_ndc};
     use crate::render::Projected;
-    use crate::render::options::Cull;
+    use crate::render::options::DrawOptions;
     use crate::render::prepare::{PrepareOutcome, Prepared, VertexCache, prepare_projected};
 
     /// Each strip ends at the first 8-row block by which the strips so far hold their
@@ -403,7 +411,7 @@ mod tests {
             let cache = VertexCache { verts, projected: pv.clone(), projected_for: Some(target) };
             let mut boxes = Vec::new();
             let outcome = prepare_projected(
-                &cache, Some(&pv), &[0, 1, 2], 0, target, Cull::None,
+                &cache, Some(&pv), &[0, 1, 2], 0, target, &DrawOptions::default(),
                 &mut |p: &Prepared<()>| boxes.push(p.setup.bbox),
             );
             if spans.contains(&ALL_ROWS) {

@@ -6,11 +6,9 @@
 //! 16-lane AVX-512 copy of the draw loop), instead of the packed shader, which shades
 //! one fragment at a time.
 
-use glam::Vec3;
-
 use super::{FrameCtx, Shading};
 use crate::counters::{self, Stage};
-use crate::raster::interp::Direction;
+use crate::raster::interp::{Direction, Homogeneous};
 use crate::render::shaders::{ColoredLambert, Lambert};
 use crate::scene::file::{Lighting, TextureMode};
 use crate::scene::plan::{ObjectPlan, VaryingSet};
@@ -79,7 +77,7 @@ pub struct StandardColoredLambert;
 
 impl Shading for StandardColoredLambert {
     const NAME: &'static str = "lambert-colors";
-    type Varying = (Vec3, Vec3);
+    type Varying = (Direction, Homogeneous);
     type Instance<'a> = ColoredLambert<'a>;
 
     fn shader<'a>(
@@ -87,7 +85,7 @@ impl Shading for StandardColoredLambert {
         plan: &'a ObjectPlan,
         ctx: FrameCtx<'a>,
     ) -> ColoredLambert<'a> {
-        ColoredLambert(StandardLambert::shader(obj, plan, ctx))
+        ColoredLambert::new(StandardLambert::shader(obj, plan, ctx))
     }
 
     fn count_work(obj: &SceneObject, shaded: u64) {

@@ -25,7 +25,7 @@ use termrast::raster::line::{Line, NoTrace};
 use termrast::raster::traverse::planes_lanes;
 use termrast::raster::{CountGrid, Reject, Setup, Target, Traversal};
 use termrast::render::probe::probe;
-use termrast::render::{Cull, DrawOptions, Prepared, Renderer, VertexCache, prepare, transform};
+use termrast::render::{DrawOptions, Prepared, Renderer, VertexCache, prepare, transform};
 
 const T: Target = Target {
     width: 96,

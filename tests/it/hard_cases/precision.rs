@@ -140,7 +140,7 @@ fn perspective_weights_stay_exact_in_small_triangles_far_from_the_origin() {
         &[0, 1, 2],
         0,
         target,
-        Cull::None,
+        &DrawOptions::default(),
         &mut |p: &Prepared<Vec3>| {
             let s = p.setup;
             for y in s.bbox.y0..=s.bbox.y1 {

@@ -12,7 +12,7 @@ use glam::{DMat4, DVec3, DVec4, Mat4, Vec2, Vec3, Vec4};
 use crate::camera::Camera;
 use crate::mesh::Mesh;
 use crate::raster::Target;
-use crate::render::{DrawOptions, Prepared, Shader, VertexCache, prepare, transform};
+use crate::render::{DrawOptions, EmitPiece, Prepared, Shader, VertexCache, prepare, transform};
 use crate::workload::{Tri2, sliver_fan, tiling, tiny_triangles};
 
 /// Names of the workloads, in table order.
@@ -216,7 +216,7 @@ pub fn projected(scene: &Scene3, target: Target) -> Vec<Tri2> {
     };
     let mut cache = VertexCache::default();
     transform(&shader, scene.positions.len(), &mut cache);
-    let mut out = Vec::new();
+    let mut pieces = Pieces(Vec::new());
     for t in 0..(scene.indices.len() / 3) as u32 {
         prepare(
             &cache,
@@ -224,12 +224,22 @@ pub fn projected(scene: &Scene3, target: Target) -> Vec<Tri2> {
             t,
             target,
             &DrawOptions::default(),
-            &mut |p: &Prepared<Vec2>| {
-                out.push(p.screen.map(|v| [f64::from(v[0]), f64::from(v[1])]));
-            },
+            &mut pieces,
         );
     }
-    out
+    pieces.0
+}
+
+/// Collects each piece's unsnapped screen positions.
+struct Pieces(Vec<Tri2>);
+
+impl EmitPiece<Vec2> for Pieces {
+    fn piece(&mut self, _: &Prepared<Vec2>) {}
+
+    fn piece_on_screen(&mut self, _: &Prepared<Vec2>, screen: &[[f32; 2]; 3]) {
+        self.0
+            .push(screen.map(|v| [f64::from(v[0]), f64::from(v[1])]));
+    }
 }
 
 /// The 2D triangles of a workload at a target size (`scale` < 1 thins the

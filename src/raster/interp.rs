@@ -143,21 +143,29 @@ impl Varying for Direction {
 /// own (the coloured Lambert's normalisation): a [`Varying::PROJECTIVE`] varying.
 /// Under perspective a pixel gets `Σ (vᵢ, 1)·bᵢ/wᵢ`, a positive multiple of the
 /// perspective-correct `(value, 1)`; in the other modes the weights sum to 1, and so
-/// does the weight up to rounding. [`Homogeneous::value`] divides.
+/// does the weight up to rounding. [`Homogeneous::value`] divides. (Four floats of
+/// 4-byte alignment, not a `Vec4`, so a record holding three is not padded.)
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Homogeneous(pub Vec4);
+pub struct Homogeneous {
+    /// The value times the weight.
+    pub scaled: Vec3,
+    pub weight: f32,
+}
 
 impl Homogeneous {
     /// `(v, 1)`: a vertex's value.
     #[must_use]
     pub fn new(v: Vec3) -> Self {
-        Self(v.extend(1.0))
+        Self {
+            scaled: v,
+            weight: 1.0,
+        }
     }
 
-    /// The value: the first three components over the weight.
+    /// The value: the scaled value over the weight.
     #[must_use]
     pub fn value(self) -> Vec3 {
-        self.0.truncate() / self.0.w
+        self.scaled / self.weight
     }
 }
 
@@ -169,17 +177,31 @@ impl Varying for Homogeneous {
     }
     #[inline(always)]
     fn projective_form(v: &[Self; 3], c: [f32; 3]) -> [Self; 3] {
-        each3!(|i| Self(v[i].0 * c[i]))
+        each3!(|i| Self {
+            scaled: v[i].scaled * c[i],
+            weight: v[i].weight * c[i],
+        })
     }
     #[inline(always)]
     fn from_relative(r: &[Self; 3], w: [f32; 3]) -> Self {
         // As `Direction`'s, per component (the coloured Lambert's lane code repeats it).
-        let [a, b, c] = each3!(|i| r[i].0);
-        Self(c.mul_add(Vec4::splat(w[2]), b.mul_add(Vec4::splat(w[1]), a * w[0])))
+        let [a, b, c] = *r;
+        Self {
+            scaled: c.scaled.mul_add(
+                Vec3::splat(w[2]),
+                b.scaled.mul_add(Vec3::splat(w[1]), a.scaled * w[0]),
+            ),
+            weight: c
+                .weight
+                .mul_add(w[2], b.weight.mul_add(w[1], a.weight * w[0])),
+        }
     }
     #[inline(always)]
     fn lerp(a: &Self, b: &Self, t: f32) -> Self {
-        Self(<Vec4 as Varying>::lerp(&a.0, &b.0, t))
+        Self {
+            scaled: <Vec3 as Varying>::lerp(&a.scaled, &b.scaled, t),
+            weight: <f32 as Varying>::lerp(&a.weight, &b.weight, t),
+        }
     }
 }
 

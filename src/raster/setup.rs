@@ -121,22 +121,21 @@ impl std::fmt::Display for Reject {
 /// Names of the three edge functions, in index order (`docs/rasterization.md`).
 pub const EDGE_NAMES: [&str; 3] = ["F01", "F02", "F03"];
 
-/// One triangle ready for traversal.
+/// One triangle ready for traversal: what the traversals read, and no more, since a
+/// threaded draw writes one per triangle and reads it back.
 ///
-/// Edge `e` runs from `v[e]` to `v[(e + 1) % 3]`: index 0 is `F01` (A→B), 1 is `F02`
-/// (B→C), 2 is `F03` (C→A).
+/// Edge `e` runs from vertex `e` to vertex `(e + 1) % 3` of the snapped vertices A, B,
+/// C in positive-area order: index 0 is `F01` (A→B), 1 is `F02` (B→C), 2 is `F03`
+/// (C→A). The constant terms `K0e` are not kept: [`Setup::origin`] holds the same
+/// information at the box's first pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Setup {
-    /// Snapped vertices A, B, C in subpixels, in positive-area order.
-    pub v: [[i64; 2]; 3],
     /// True when the input was wound the other way and B, C were swapped.
     pub flipped: bool,
     /// `I0e`: change of `F0e` per subpixel step in x.
     pub i: [i64; 3],
     /// `J0e`: change of `F0e` per subpixel step in y.
     pub j: [i64; 3],
-    /// `K0e`: `F0e` at the origin.
-    pub k: [i64; 3],
     /// 0 for top and left edges, −1 for the others (the fill rule).
     pub bias: [i64; 3],
     /// Doubled area in subpixel² units, always > 0; equals `F01 + F02 + F03` everywhere.
@@ -213,11 +212,9 @@ impl Setup {
         let origin = each3!(|e| i[e] * px + j[e] * py + k[e] + bias[e]);
 
         Ok(Self {
-            v,
             flipped,
             i,
             j,
-            k,
             bias,
             area2,
             bbox,
@@ -229,7 +226,10 @@ impl Setup {
     #[must_use]
     #[inline]
     pub fn edge_at_subpixel(&self, e: usize, px: i64, py: i64) -> i64 {
-        self.i[e] * px + self.j[e] * py + self.k[e]
+        // From the box's first pixel centre, where the biased value is `origin`.
+        let x0 = i64::from(self.bbox.x0) * SUBPIXEL_ONE + HALF_PIXEL;
+        let y0 = i64::from(self.bbox.y0) * SUBPIXEL_ONE + HALF_PIXEL;
+        self.origin[e] - self.bias[e] + self.i[e] * (px - x0) + self.j[e] * (py - y0)
     }
 
     /// Raw `F0e` (no fill-rule bias) at the centre of pixel `(x, y)`, evaluated directly.

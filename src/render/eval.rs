@@ -107,7 +107,7 @@ impl<V: Varying> Prepared<V> {
         let q = self.vertex_edges(f);
         let ia = self.inv_area2;
         let bary = [q[0] * ia, q[1] * ia, q[2] * ia];
-        let depth = depth_of(q, self.z[0], self.zc);
+        let depth = depth_of(q, self.z, self.zc);
         let (persp, inv_w) = perspective_weights(q, self.pc);
         PixelEval {
             x,
@@ -126,7 +126,7 @@ impl<V: Varying> Prepared<V> {
     #[must_use]
     pub fn depth_at(&self, x: u32, y: u32) -> f32 {
         let q = self.vertex_edges(self.raw_edges(x, y));
-        depth_of(q, self.z[0], self.zc)
+        depth_of(q, self.z, self.zc)
     }
 
     /// Raw `F01, F02, F03` at the centre of pixel `(x, y)`.
@@ -164,7 +164,7 @@ impl<V: Varying> Prepared<V> {
     /// [`depth_lanes`] of this triangle: [`Prepared::depth_at`] on lanes.
     #[inline(always)]
     pub(super) fn depth_lanes<F: F32s>(&self, q: [F; 3]) -> F {
-        depth_lanes(q, self.z[0], &self.zc)
+        depth_lanes(q, self.z, &self.zc)
     }
 
     /// Perspective-correct weights at the centre of pixel `(x, y)`, which may lie

@@ -31,12 +31,8 @@ pub struct Prepared<V> {
     /// Whether clipping cut the original triangle.
     pub clipped: bool,
     pub setup: Setup,
-    /// Screen position (pixels) of each vertex before snapping.
-    pub screen: [[f32; 2]; 3],
-    /// NDC depth of each vertex.
-    pub z: [f32; 3],
-    /// 1/w of each vertex.
-    pub inv_w: [f32; 3],
+    /// NDC depth of vertex A (see [`Prepared::zc`]).
+    pub z: f32,
     /// The varyings in the form the draw's interpolation mode reads: relative (see
     /// [`Varying::relative`]), or for a [`Varying::PROJECTIVE`] varying under
     /// perspective the vertex values times `pc` ([`Varying::projective_form`]),
@@ -142,6 +138,15 @@ pub fn transform_projected<S: Shader>(
 /// on their own, without the caller's target features).
 pub trait EmitPiece<V> {
     fn piece(&mut self, p: &Prepared<V>);
+
+    /// [`EmitPiece::piece`] with the piece's screen positions (pixels, before
+    /// snapping, setup order), which the record does not keep: for the few callers
+    /// that want them.
+    #[inline(always)]
+    fn piece_on_screen(&mut self, p: &Prepared<V>, screen: &[[f32; 2]; 3]) {
+        let _ = screen;
+        self.piece(p);
+    }
 }
 
 impl<V, F: FnMut(&Prepared<V>)> EmitPiece<V> for F {
@@ -368,6 +373,7 @@ fn setup_piece<V: Varying>(
     let edge_rem = each3!(|e| (setup.origin[e] - setup.bias[e] - (g[e] << SUBPIXEL_BITS)) as f32);
     let z = each3!(|i| pv[order(i)].z);
     let inv_w = each3!(|i| pv[order(i)].inv_w);
+    let screen = each3!(|i| pv[order(i)].screen);
     // In f64, rounded once: the per-pixel terms then carry one rounding each.
     let ia = 1.0 / setup.area2 as f64;
     let slope = |i: usize| ((f64::from(z[i]) - f64::from(z[0])) * ia) as f32;
@@ -379,20 +385,19 @@ fn setup_piece<V: Varying>(
     } else {
         V::relative(&var[0], &var[1], &var[2])
     };
-    emit.piece(&Prepared {
+    let prepared = Prepared {
         triangle: t,
         piece: piece as u8,
         clipped,
         setup,
-        screen: each3!(|i| pv[order(i)].screen),
-        z,
-        inv_w,
+        z: z[0],
         zc,
         pc,
         rel,
         inv_area2: ia as f32,
         edge_rem,
-    });
+    };
+    emit.piece_on_screen(&prepared, &screen);
     Piece::Drawn
 }
 

@@ -33,7 +33,8 @@ pub struct ProbeRecord<V> {
     pub triangle: u32,
     pub piece: u8,
     pub clipped: bool,
-    /// The triangle's setup: snapped vertices, I/J/K, bias, doubled area, winding.
+    /// The triangle's setup: I/J, bias, doubled area, winding, box and the edge
+    /// values at its first pixel.
     pub setup: Setup,
     pub eval: PixelEval,
     pub depth: DepthOutcome,

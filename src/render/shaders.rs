@@ -175,18 +175,18 @@ impl<'a> ColoredLambert<'a> {
     /// Written out, with fused multiply-adds, so [`ColoredLambert::shade_lanes`]
     /// repeats it bit for bit.
     #[inline(always)]
-    fn shade(&self, n: Vec3, h: Vec4) -> Vec3 {
+    fn shade(&self, n: Vec3, h: Homogeneous) -> Vec3 {
         let lt = self.light;
         let len2 = n.z.mul_add(n.z, n.y.mul_add(n.y, n.x * n.x));
         let len = max(len2.sqrt(), MIN_NORMAL_LENGTH);
         let d = n.z.mul_add(lt.z, n.y.mul_add(lt.y, n.x * lt.x));
-        let m = len.mul_add(self.lambert.ambient, max(d, 0.0)) * (1.0 / (len * h.w));
-        Vec3::new(h.x * m, h.y * m, h.z * m)
+        let m = len.mul_add(self.lambert.ambient, max(d, 0.0)) * (1.0 / (len * h.weight));
+        h.scaled * m
     }
 
     /// [`ColoredLambert::shade`] on lanes.
     #[inline(always)]
-    fn shade_lanes<F: F32s>(&self, [x, y, z]: [F; 3], h: [F; 4]) -> [F; 3] {
+    fn shade_lanes<F: F32s>(&self, [x, y, z]: [F; 3], h: [F; 3], weight: F) -> [F; 3] {
         let lt = self.light;
         let len = z
             .mul_add(z, y.mul_add(y, x * x))
@@ -197,7 +197,7 @@ impl<'a> ColoredLambert<'a> {
             y.mul_add(F::splat(lt.y), x * F::splat(lt.x)),
         );
         let ambient = F::splat(self.lambert.ambient);
-        let m = len.mul_add(ambient, d.max(F::splat(0.0))) * (F::splat(1.0) / (len * h[3]));
+        let m = len.mul_add(ambient, d.max(F::splat(0.0))) * (F::splat(1.0) / (len * weight));
         each3!(|i| h[i] * m)
     }
 }
@@ -215,7 +215,7 @@ impl Shader for ColoredLambert<'_> {
     }
 
     #[inline(always)]
-    fn fragment(&self, &(Direction(n), Homogeneous(h)): &(Direction, Homogeneous)) -> Vec3 {
+    fn fragment(&self, &(Direction(n), h): &(Direction, Homogeneous)) -> Vec3 {
         self.shade(n, h)
     }
 
@@ -227,18 +227,14 @@ impl Shader for ColoredLambert<'_> {
         _mask: u32,
     ) -> ShadeLanes<F> {
         let [
-            (Direction(na), Homogeneous(ha)),
-            (Direction(nb), Homogeneous(hb)),
-            (Direction(nc), Homogeneous(hc)),
+            (Direction(na), ha),
+            (Direction(nb), hb),
+            (Direction(nc), hc),
         ] = *rel;
         let n = each3!(|i| weigh_lanes([na[i], nb[i], nc[i]], w));
-        let h = [
-            weigh_lanes([ha.x, hb.x, hc.x], w),
-            weigh_lanes([ha.y, hb.y, hc.y], w),
-            weigh_lanes([ha.z, hb.z, hc.z], w),
-            weigh_lanes([ha.w, hb.w, hc.w], w),
-        ];
-        ShadeLanes::Rgb(self.shade_lanes(n, h))
+        let h = each3!(|i| weigh_lanes([ha.scaled[i], hb.scaled[i], hc.scaled[i]], w));
+        let weight = weigh_lanes([ha.weight, hb.weight, hc.weight], w);
+        ShadeLanes::Rgb(self.shade_lanes(n, h, weight))
     }
 }
 
@@ -415,7 +411,10 @@ mod tests {
         );
         let colour = Vec3::new(0.8, 0.4, 1.0);
         for s in [1e-3, 0.4, 1.0, 7.0] {
-            let h = Homogeneous((colour * base * s).extend(s));
+            let h = Homogeneous {
+                scaled: colour * base * s,
+                weight: s,
+            };
             let got = shader.fragment(&(Direction(Vec3::ZERO), h));
             let want = colour * base * 0.2;
             assert!(

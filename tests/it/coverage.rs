@@ -182,8 +182,10 @@ proptest! {
                 prop_assert!(v.iter().all(|c| c.abs() <= limit));
                 let centre = |p: u32| i128::from(p) * 256 + 128;
                 let (px, py) = (centre(s.bbox.x0), centre(s.bbox.y0));
+                // The vertices in setup order (positive area).
+                let sv = s.unflip(fixed);
                 for e in 0..3 {
-                    let (a, b) = (s.v[e].map(i128::from), s.v[(e + 1) % 3].map(i128::from));
+                    let (a, b) = (sv[e].map(i128::from), sv[(e + 1) % 3].map(i128::from));
                     let f = (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0]);
                     prop_assert_eq!(i128::from(s.origin[e]), f + i128::from(s.bias[e]), "edge {}", e);
                 }

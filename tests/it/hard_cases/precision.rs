@@ -143,6 +143,8 @@ fn perspective_weights_stay_exact_in_small_triangles_far_from_the_origin() {
         &DrawOptions::default(),
         &mut |p: &Prepared<Vec3>| {
             let s = p.setup;
+            // 1/w of each vertex, in setup order.
+            let inv_w = s.unflip([0.01f32, 10.0, 1.0]).map(|w| 1.0 / w);
             for y in s.bbox.y0..=s.bbox.y1 {
                 for x in s.bbox.x0..=s.bbox.x1 {
                     let e = p.eval(x, y);
@@ -152,7 +154,7 @@ fn perspective_weights_stay_exact_in_small_triangles_far_from_the_origin() {
                     }
                     let a = s.area2 as f64;
                     let b = [e.f[1] as f64 / a, e.f[2] as f64 / a, e.f[0] as f64 / a];
-                    let q: Vec<f64> = (0..3).map(|i| b[i] * f64::from(p.inv_w[i])).collect();
+                    let q: Vec<f64> = (0..3).map(|i| b[i] * f64::from(inv_w[i])).collect();
                     let sum: f64 = q.iter().sum();
                     for (i, (got, q)) in e.persp.iter().zip(&q).enumerate() {
                         let want = q / sum;

@@ -187,10 +187,7 @@ impl Varying for Homogeneous {
         // As `Direction`'s, per component (the coloured Lambert's lane code repeats it).
         let [a, b, c] = *r;
         Self {
-            scaled: c.scaled.mul_add(
-                Vec3::splat(w[2]),
-                b.scaled.mul_add(Vec3::splat(w[1]), a.scaled * w[0]),
-            ),
+            scaled: Direction::from_relative(&each3!(|i| Direction(r[i].scaled)), w).0,
             weight: c
                 .weight
                 .mul_add(w[2], b.weight.mul_add(w[1], a.weight * w[0])),

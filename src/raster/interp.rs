@@ -143,7 +143,7 @@ impl Varying for Direction {
 /// own (the coloured Lambert's normalisation): a [`Varying::PROJECTIVE`] varying.
 /// Under perspective a pixel gets `Σ (vᵢ, 1)·bᵢ/wᵢ`, a positive multiple of the
 /// perspective-correct `(value, 1)`; in the other modes the weights sum to 1, and so
-/// does the weight up to rounding. [`Homogeneous::value`] divides. (Four floats of
+/// does the weight up to rounding. The value is `scaled / weight`. (Four floats of
 /// 4-byte alignment, not a `Vec4`, so a record holding three is not padded.)
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Homogeneous {
@@ -160,12 +160,6 @@ impl Homogeneous {
             scaled: v,
             weight: 1.0,
         }
-    }
-
-    /// The value: the scaled value over the weight.
-    #[must_use]
-    pub fn value(self) -> Vec3 {
-        self.scaled / self.weight
     }
 }
 

@@ -212,6 +212,14 @@ impl Renderer {
         self.frame_threads = self.frame_bins || (on_pool && work >= self.min_strip_work);
     }
 
+    /// Sets the shares of the vertices that the strips of the frame's draw number
+    /// `draw` (from 0) start from, one per thread (in strips, [`Spread::Strips`]):
+    /// equal at first, then corrected after each draw by the time each strip took.
+    /// Tests set uneven ones.
+    pub fn set_strip_shares(&mut self, draw: usize, shares: &[f32]) {
+        self.scratch.shares(draw).set(shares);
+    }
+
     /// The renderer's threads, if more than one, whatever the frame: a caller that
     /// runs its frame loop inside (`install`) hands no frame from thread to thread,
     /// and lets small frames be shared too ([`Renderer::plan_frame`]).
@@ -330,6 +338,7 @@ impl Renderer {
             color.reset(target.len(), background);
         }
         self.stats = DrawStats::default();
+        self.scratch.begin_frame();
     }
 
     /// Clears the colour target if a deferred clear is still pending (no draw of the

@@ -105,6 +105,13 @@ pub(super) struct Scratch {
     pub(super) rows: Vec<u32>,
     /// Per vertex, the rows a box takes from it (`strips::vertex_spans`).
     pub(super) spans: Vec<u32>,
+    /// Per draw of a frame (the first [`strips::SHARED_DRAWS`], the rest sharing the
+    /// last), each strip's share of the vertices, corrected by the strips' times. Out
+    /// of line (made by the first draw in strips): the renderer's fields stay close
+    /// together for the one-thread draw loop.
+    pub(super) shares: Vec<strips::Shares>,
+    /// The draws in strips so far in this frame ([`Scratch::begin_frame`]).
+    pub(super) strip_draws: usize,
 }
 
 impl std::fmt::Debug for Scratch {
@@ -116,6 +123,20 @@ impl std::fmt::Debug for Scratch {
 }
 
 impl Scratch {
+    /// Starts counting a frame's draws again, so each draw keeps its own shares.
+    pub(super) fn begin_frame(&mut self) {
+        self.strip_draws = 0;
+    }
+
+    /// The shares of the frame's draw number `draw` (the last kept for later ones).
+    pub(super) fn shares(&mut self, draw: usize) -> &mut strips::Shares {
+        if self.shares.is_empty() {
+            self.shares
+                .resize(strips::SHARED_DRAWS, strips::Shares::default());
+        }
+        &mut self.shares[draw.min(strips::SHARED_DRAWS - 1)]
+    }
+
     /// The chunks for varying type `V`: `chunks` of them, each with `bands` empty bins,
     /// and the band order and costs.
     fn chunks<V: Send + 'static>(

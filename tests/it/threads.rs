@@ -198,6 +198,36 @@ fn many_threads_draw_the_same_frame() {
     }
 }
 
+/// Frame after frame through one renderer drawing in strips, whose borders move with
+/// the strips' times and with uneven shares set before some frames: each frame is
+/// one thread's.
+#[test]
+fn strips_frame_after_frame_equal_one_thread() {
+    let scene = model("bunny");
+    let target = Target::new(150, 4 * BAND_ROWS + 3);
+    let options = (Interpolation::Perspective, Traversal::Wide, Isa::detect());
+    let mut frame = SceneFrame::new(&scene);
+    (frame.interpolation, frame.traversal, frame.renderer.isa) = options;
+    frame.renderer.set_threads(2);
+    share(&mut frame.renderer, Spread::Strips, true);
+    let pool = frame.renderer.thread_pool().cloned().expect("two threads");
+    for n in 0..24 {
+        match n % 6 {
+            2 => frame.renderer.set_strip_shares(0, &[0.2, 0.8]),
+            5 => frame.renderer.set_strip_shares(0, &[0.9, 0.1]),
+            _ => {}
+        }
+        let view = turned(0.3 * n as f32);
+        pool.install(|| frame.draw(&scene, target, &view));
+        assert_eq!(frame.renderer.spread(), Spread::Strips);
+        let depth = frame.renderer.depth.to_vec();
+        let depth: Vec<u32> = depth.iter().map(|d| d.to_bits()).collect();
+        let many = (frame.color.0.clone(), depth, frame.stats);
+        let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
+        assert!(one == many, "frame {n}");
+    }
+}
+
 /// The probe, which recomputes a pixel from scratch on one thread, equals the frame
 /// drawn on two at every pixel.
 #[test]
@@ -252,9 +282,24 @@ fn draw_direct(
     opts: &DrawOptions,
     (threads, way): (usize, Spread),
 ) -> Drawn {
+    draw_direct_shared(shader, indices, target, opts, (threads, way), &[])
+}
+
+/// [`draw_direct`], the strips starting from `shares` of the vertices if given.
+fn draw_direct_shared(
+    shader: &Direct,
+    indices: &[u32],
+    target: Target,
+    opts: &DrawOptions,
+    (threads, way): (usize, Spread),
+    shares: &[f32],
+) -> Drawn {
     let mut r = Renderer::new(target);
     r.set_threads(threads);
     share(&mut r, way, false);
+    if !shares.is_empty() {
+        r.set_strip_shares(0, shares);
+    }
     let mut out = Exact::default();
     let mut cache = VertexCache::default();
     r.begin_frame(target, &mut out, Vec3::ZERO);
@@ -338,7 +383,7 @@ fn triangles_crossing_a_band_border_at_every_subpixel_draw_the_same() {
         project_vertices(&cache, target, &mut pv);
         let mut spans = Vec::new();
         vertex_spans(&pv, target.height, &mut spans);
-        let ends = strip_ends(&spans, target.height, 2, &mut Vec::new()).0;
+        let ends = strip_ends(&spans, target.height, &[1.0; 2], &mut Vec::new()).0;
         assert_eq!(
             ends[0], border as u32,
             "{target:?} {sub}: the strips' border"
@@ -374,10 +419,11 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
     /// Random triangles, any traversal, interpolation and depth test, on targets
-    /// from one band to several: 1, 2 and 3 threads, binned or in strips, draw the
-    /// same.
+    /// from one band to several: 1, 2 and 3 threads, binned or in strips (from
+    /// random shares of the vertices), draw the same.
     #[test]
     fn random_triangles_draw_the_same_on_every_thread_count(
+        shares in prop::collection::vec(0.0f32..4.0, 3),
         clip in prop::collection::vec(vertex(), 3..40),
         tris in prop::collection::vec(any::<[prop::sample::Index; 3]>(), 1..30),
         (w, h) in (1u32..90, 1u32..(3 * BAND_ROWS + 7)),
@@ -396,7 +442,8 @@ proptest! {
         let one = draw_direct(&shader, &indices, target, &o, (1, Spread::One));
         for threads in [2, 3] {
             for way in WAYS {
-                let many = draw_direct(&shader, &indices, target, &o, (threads, way));
+                let shares = &shares[..threads];
+                let many = draw_direct_shared(&shader, &indices, target, &o, (threads, way), shares);
                 prop_assert!(one == many, "{} threads, {:?}", threads, way);
             }
         }

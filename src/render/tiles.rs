@@ -106,9 +106,8 @@ pub(super) struct Scratch {
     /// Per vertex, the rows a box takes from it (`strips::vertex_spans`).
     pub(super) spans: Vec<u32>,
     /// Per draw of a frame (the first [`strips::SHARED_DRAWS`], the rest sharing the
-    /// last), each strip's share of the vertices, corrected by the strips' times. Out
-    /// of line (made by the first draw in strips): the renderer's fields stay close
-    /// together for the one-thread draw loop.
+    /// last), each strip's share of the vertices, corrected by the strips' times. Made
+    /// by the first draw in strips.
     pub(super) shares: Vec<strips::Shares>,
     /// The draws in strips so far in this frame ([`Scratch::begin_frame`]).
     pub(super) strip_draws: usize,

@@ -71,8 +71,8 @@ const _: () = assert!(OUT_W_NOT_POSITIVE == 1 << 6 && OUT_NOT_FINITE == 1 << 7);
 /// Eight vertices' projections (see [`Projected::of`] for each field).
 #[inline(always)]
 fn project8<V>(v: &[ClipVertex<V>], target: Target, guard: [f32; 2], out: &mut [Projected]) {
-    // Written out rather than `array::from_fn`, whose call the compiler may leave out of
-    // line in some builds (it did, costing the projection 70 %).
+    // Written out rather than `array::from_fn`, whose call the compiler leaves out of
+    // line in some builds.
     let v = &v[..8];
     let lane = |c: usize| {
         f32x8::from([

@@ -17,10 +17,9 @@
 //! draw): at first each holds as many, then each draw's shares are corrected by the
 //! time each strip took to end ([`Shares`]), since a vertex costs more where its
 //! triangles are larger or the other thread starts later. The strips are worth it only
-//! to a caller that runs
-//! on the pool's threads itself (`Renderer::plan_frame`): handing a frame of a few
-//! hundred microseconds to a sleeping thread and waiting for it to be handed back
-//! costs more than the second thread saves.
+//! to a caller that runs on the pool's threads itself (`Renderer::plan_frame`):
+//! handing a frame of a few hundred microseconds to a sleeping thread and waiting for
+//! it to be handed back costs more than the second thread saves.
 //!
 //! Every triangle is counted by one strip (its owner), so the counters are one
 //! thread's: the strip that holds the first row of its box (clamped to the target),

@@ -67,7 +67,7 @@ const EQUAL: [f32; MAX_STRIPS] = [1.0; MAX_STRIPS];
 impl Default for Shares {
     fn default() -> Self {
         Self {
-            shares: [1.0; MAX_STRIPS],
+            shares: EQUAL,
             strips: 0,
         }
     }

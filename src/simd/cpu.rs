@@ -86,10 +86,14 @@ pub fn prefetch<T>(value: &T) {
     {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
         let start = std::ptr::from_ref(value).cast::<i8>();
-        for offset in (0..size_of::<T>()).step_by(64) {
-            // SAFETY: SSE is part of x86-64, and a prefetch never faults; the address
-            // lies within `value` anyway.
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
+        // From the line holding the first byte: a value that does not start a line
+        // reaches one line further than its size.
+        let lead = start.addr() % 64;
+        let line = start.wrapping_sub(lead);
+        for offset in (0..lead + size_of::<T>()).step_by(64) {
+            // SAFETY: SSE is part of x86-64, and a prefetch never faults (each address
+            // lies in a line that holds part of `value` anyway).
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(line.wrapping_add(offset)) };
         }
     }
     #[cfg(not(target_arch = "x86_64"))]

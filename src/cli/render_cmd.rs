@@ -117,6 +117,14 @@ pub struct BenchRenderArgs {
     /// this CPU has). All give identical images.
     #[arg(long, value_parser = super::parse_isa)]
     pub isa: Option<Isa>,
+    /// Milliseconds to wait before each frame (untimed), as the viewer waits between
+    /// its frames and its threads fall idle; 0 draws the frames back to back.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u64).range(0..=1000))]
+    pub pause_ms: u64,
+    /// Draw each frame on the threads or on the calling thread, whichever frames have
+    /// been faster on, as the viewer does (by default every frame uses the threads).
+    #[arg(long)]
+    pub measured: bool,
 }
 
 /// Refuses an `--out` path that is not a PNG, before anything is rendered or created
@@ -303,6 +311,8 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
     if let Some(isa) = args.isa {
         frame.renderer.isa = isa;
     }
+    frame.renderer.set_measured(args.measured);
+    let pause = std::time::Duration::from_millis(args.pause_ms);
     let frames = args.frames.max(1);
     let mut times = Vec::with_capacity(frames as usize);
     let mut covered = 0u64;
@@ -313,6 +323,9 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
                 yaw: n as f32 * RADIANS_PER_FRAME,
                 ..SceneView::default()
             };
+            if !pause.is_zero() {
+                std::thread::sleep(pause);
+            }
             let start = Instant::now();
             frame.draw(&scene, target, &view);
             times.push(start.elapsed().as_secs_f64() * 1e3);

@@ -165,10 +165,11 @@ pub fn view(args: &ViewArgs) -> Result<(), super::CliError> {
     let scene = load(&args.model, args.mode, args.cull)?;
     let warned = scene.warnings.len();
     let mut app = App::new(scene, args.look.settings());
-    app.scene
-        .frame
-        .renderer
-        .set_threads(super::threads_or_cores(args.threads));
+    let renderer = &mut app.scene.frame.renderer;
+    renderer.set_threads(super::threads_or_cores(args.threads));
+    // Frames 30 times a second leave the threads idle in between: each frame goes the
+    // way (the threads or this one) that has been faster.
+    renderer.set_measured(true);
     app.notice = args.look.notice_in(env).or_else(|| {
         (warned > 0).then(|| {
             format!(

@@ -44,6 +44,7 @@
 //! No call may sit in a group loop, taken or not: every vector register is lost
 //! across it.
 
+mod choice;
 pub mod eval;
 mod fragments;
 mod isa;
@@ -112,6 +113,10 @@ pub struct Renderer {
     frame_threads: bool,
     /// Whether this frame is worth binning ([`Spread::Bins`]).
     frame_bins: bool,
+    /// For a loop that draws paced frames, the measured choice between the pool and
+    /// the calling thread ([`Renderer::set_measured`]); `None` uses the pool for
+    /// every frame worth it.
+    choice: Option<choice::FrameChoice>,
 }
 
 /// The fewest vertices the one-thread vertex stage projects in its own pass
@@ -168,6 +173,7 @@ impl Renderer {
             spread: Spread::One,
             frame_threads: true,
             frame_bins: true,
+            choice: None,
         }
     }
 
@@ -203,6 +209,10 @@ impl Renderer {
     /// the calling thread is one of the pool's ([`Renderer::thread_pool`]) and the
     /// frame has at least [`Renderer::min_strip_work`]: then its draws are shared in
     /// strips ([`Spread::Strips`]).
+    ///
+    /// With [`Renderer::set_measured`], a frame worth the pool may still be drawn on
+    /// the calling thread, if frames of this work have been faster there; the caller
+    /// then reports each frame's time ([`Renderer::frame_took`]).
     pub fn plan_frame(&mut self, work: u64) {
         let on_pool = self
             .pool
@@ -210,6 +220,38 @@ impl Renderer {
             .is_some_and(|p| p.current_thread_index().is_some());
         self.frame_bins = work >= self.min_threaded_work;
         self.frame_threads = self.frame_bins || (on_pool && work >= self.min_strip_work);
+        if self.frame_threads
+            && self.pool.is_some()
+            && let Some(choice) = &mut self.choice
+            && !choice.pooled(work)
+        {
+            self.frame_threads = false;
+            self.frame_bins = false;
+        }
+    }
+
+    /// Chooses from now on, frame by frame, between the pool and the calling thread
+    /// by how long recent frames took each way (`render::choice`): for a loop that
+    /// draws frames now and then, such as the viewer, whose idle threads can make a
+    /// frame slower on the pool than on one thread. Both ways draw the same frame.
+    /// Off by default: a benchmark uses the threads it is given.
+    pub fn set_measured(&mut self, on: bool) {
+        self.choice = on.then(choice::FrameChoice::default);
+    }
+
+    /// Reports how long the frame planned last ([`Renderer::plan_frame`]) took to
+    /// draw, for the measured choice; without it, or for a frame the pool was not
+    /// considered for, nothing happens.
+    pub fn frame_took(&mut self, took: std::time::Duration) {
+        if let Some(choice) = &mut self.choice {
+            choice.took(took);
+        }
+    }
+
+    /// Whether the frame planned last may use the pool.
+    #[must_use]
+    pub fn frame_pooled(&self) -> bool {
+        self.pool.is_some() && self.frame_threads
     }
 
     /// Sets the shares of the vertices that the strips of the frame's draw number

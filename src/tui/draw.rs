@@ -214,11 +214,15 @@ impl App {
         s.push(
             Priority::Timing,
             format!(
-                "transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms",
+                "transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms, {}",
                 ms(tf),
                 ms(rs),
                 ms(self.viewport.glyph_time),
-                ms(self.output_time)
+                ms(self.output_time),
+                match (frame.renderer.frame_pooled(), frame.renderer.threads()) {
+                    (true, n) if n > 1 => format!("{n} threads"),
+                    _ => "1 thread".to_string(),
+                }
             ),
         );
         s.push(

@@ -170,6 +170,37 @@ fn threads_takes_a_count_from_one() {
     }
 }
 
+/// `bench render --pause-ms` waits at most a second before each frame (so a long
+/// run cannot be asked for by a slip of the keyboard); with `--measured` the frames
+/// are timed as the viewer's are.
+#[test]
+fn bench_pause_is_bounded() {
+    let dir = scratch("pause");
+    for bad in ["1001", "-1", "soon"] {
+        let pause = format!("--pause-ms={bad}");
+        let args = ["bench", "render", &pause, "--frames", "1"];
+        let (code, _, err) = run_in(&dir, &args);
+        assert_eq!(code, Some(2), "{bad}: {err}");
+        assert!(err.contains("--pause-ms"), "{bad}: {err}");
+    }
+    let args = [
+        "bench",
+        "render",
+        "--pause-ms",
+        "1",
+        "--measured",
+        "--threads",
+        "2",
+        "--frames",
+        "8",
+        "--size",
+        "32x32",
+    ];
+    let (code, out, err) = run_in(&dir, &args);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.contains("threads=2"), "{out}");
+}
+
 #[test]
 fn render_out_in_an_unsupported_format_leaves_no_file() {
     let dir = scratch("out");

@@ -228,6 +228,39 @@ fn strips_frame_after_frame_equal_one_thread() {
     }
 }
 
+/// With the measured choice (`Renderer::set_measured`, as in the viewer) a frame goes
+/// to the pool or stays on the calling thread by how long earlier frames took each
+/// way: both ways are taken within the first frames, and every frame is one thread's.
+#[test]
+fn measured_frames_take_both_ways_and_equal_one_thread() {
+    let options = (Interpolation::Perspective, Traversal::Wide, Isa::detect());
+    for way in WAYS {
+        let scene = model("bunny");
+        let target = Target::new(120, 2 * BAND_ROWS + 5);
+        let mut frame = SceneFrame::new(&scene);
+        (frame.interpolation, frame.traversal, frame.renderer.isa) = options;
+        frame.renderer.set_threads(2);
+        frame.renderer.set_measured(true);
+        share(&mut frame.renderer, way, true);
+        let pool = frame.renderer.thread_pool().cloned().expect("two threads");
+        let mut pooled = [0; 2];
+        for n in 0..12 {
+            let view = turned(0.2 * n as f32);
+            pool.install(|| frame.draw(&scene, target, &view));
+            let on_pool = frame.renderer.frame_pooled();
+            pooled[usize::from(on_pool)] += 1;
+            let expected = if on_pool { way } else { Spread::One };
+            assert_eq!(frame.renderer.spread(), expected, "frame {n}");
+            let depth = frame.renderer.depth.to_vec();
+            let depth: Vec<u32> = depth.iter().map(|d| d.to_bits()).collect();
+            let bits = (frame.color.0.clone(), depth, frame.stats);
+            let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
+            assert!(one == bits, "{way:?} frame {n}");
+        }
+        assert!(pooled.iter().all(|&n| n >= 3), "{way:?}: {pooled:?}");
+    }
+}
+
 /// The probe, which recomputes a pixel from scratch on one thread, equals the frame
 /// drawn on two at every pixel.
 #[test]

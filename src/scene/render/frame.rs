@@ -140,12 +140,14 @@ impl SceneFrame {
         self.renderer.plan_frame(
             target.len() as u64 * side + crate::render::TRIANGLE_WORK * triangles as u64,
         );
+        let start = Instant::now();
         match self.renderer.pool().cloned() {
             // The whole frame on the pool: its steps then start their parallel work
             // from one of its threads, without waking the pool for each.
             Some(pool) => pool.install(|| self.draw_here(scene, target, view)),
             None => self.draw_here(scene, target, view),
         }
+        self.renderer.frame_took(start.elapsed());
     }
 
     /// [`SceneFrame::draw`] on the calling thread.

@@ -118,6 +118,8 @@ pub struct ViewArgs {
     #[arg(long)]
     pub no_pacing: bool,
     /// Drawing threads (default: the machine's cores); 1 draws on the viewer's thread.
+    /// With more, each frame goes to them or stays on the viewer's thread, whichever
+    /// recent frames were faster on (the status line says which).
     #[arg(long, value_parser = super::parse_threads)]
     pub threads: Option<usize>,
 }

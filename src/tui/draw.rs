@@ -219,9 +219,10 @@ impl App {
                 ms(rs),
                 ms(self.viewport.glyph_time),
                 ms(self.output_time),
-                match (frame.renderer.frame_pooled(), frame.renderer.threads()) {
-                    (true, n) if n > 1 => format!("{n} threads"),
-                    _ => "1 thread".to_string(),
+                if frame.renderer.frame_pooled() {
+                    format!("{} threads", frame.renderer.threads())
+                } else {
+                    "1 thread".to_string()
                 }
             ),
         );

@@ -332,6 +332,20 @@ fn fps_never_exceeds_the_cap() {
     t.assert_restored();
 }
 
+/// The status line's timings name the way the frame was drawn: on one thread here.
+#[test]
+fn the_status_line_names_the_drawing_threads() {
+    let Some(t) = Tmux::sized("threads", "sh", 260, 40) else {
+        eprintln!("tmux not installed: skipping the terminal end-to-end test");
+        return;
+    };
+    t.start_viewer_with("TERM=xterm-256color LANG=C.UTF-8", "--threads 1");
+    let s = t.wait_until(|s| status(s).contains(" ms, "));
+    assert!(status(&s).contains(" ms, 1 thread |"), "{}", status(&s));
+    t.keys(&["q"]);
+    t.assert_restored();
+}
+
 impl Tmux {
     /// The viewer's process: the child of the pane's shell.
     fn viewer_pid(&self) -> String {

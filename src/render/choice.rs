@@ -60,12 +60,14 @@ impl Times {
 }
 
 /// The measured choice between the pool and the calling thread, for frames of one
-/// amount of work ([`crate::render::Renderer::plan_frame`]): another amount (another
-/// mesh, target size or sampling) starts the measuring again.
+/// amount and kind of work ([`crate::render::Renderer::plan_frame`]): another amount
+/// (another mesh, target size or sampling) or kind (edges drawn instead of triangles,
+/// back faces culled) starts the measuring again, as its times say nothing of it.
 #[derive(Clone, Debug, Default)]
 pub struct FrameChoice {
-    /// The work the times are for.
+    /// The work the times are for, and its kind.
     work: u64,
+    kind: u64,
     /// Times on the calling thread ([0]) and on the pool ([1]).
     times: [Times; 2],
     /// The way chosen so far: on the pool.
@@ -81,11 +83,12 @@ pub struct FrameChoice {
 }
 
 impl FrameChoice {
-    /// Whether the coming frame, of `work`, goes to the pool.
-    pub fn pooled(&mut self, work: u64) -> bool {
-        if !similar(work, self.work) {
+    /// Whether the coming frame, of `work` of kind `kind`, goes to the pool.
+    pub fn pooled(&mut self, work: u64, kind: u64) -> bool {
+        if !similar(work, self.work) || kind != self.kind {
             *self = Self {
                 work,
+                kind,
                 pooled: true,
                 ..Self::default()
             };
@@ -165,7 +168,7 @@ mod tests {
     ) -> u32 {
         let (mut pooled, mut row, mut last) = (0, 0, None);
         for _ in 0..frames {
-            let way = c.pooled(work);
+            let way = c.pooled(work, 0);
             row = if last == Some(way) { row + 1 } else { 0 };
             last = Some(way);
             pooled += u32::from(way);
@@ -186,7 +189,7 @@ mod tests {
         let mut c = FrameChoice::default();
         let first: Vec<bool> = (0..FIRST)
             .map(|_| {
-                let way = c.pooled(100);
+                let way = c.pooled(100, 0);
                 c.took(Duration::from_millis(if way { 8 } else { 5 }));
                 way
             })
@@ -237,17 +240,17 @@ mod tests {
         }
     }
 
-    /// Another amount of work starts over; a little more or less (within an eighth)
-    /// does not. A time with no frame given a way changes nothing.
+    /// Another amount or kind of work starts over; a little more or less (within an
+    /// eighth) does not. A time with no frame given a way changes nothing.
     #[test]
     fn other_work_measures_again() {
         let mut c = FrameChoice::default();
         run(&mut c, 1000, FIRST + 10, 8.0, 5.0);
         assert!(!c.pooled);
-        assert!(!c.pooled(1100), "within an eighth: the same choice");
+        assert!(!c.pooled(1100, 0), "within an eighth: the same choice");
         c.took(Duration::from_millis(5));
         assert!(
-            c.pooled(2000),
+            c.pooled(2000, 0),
             "another mesh or size: measured again, pool first"
         );
         c.took(Duration::from_millis(8));
@@ -256,11 +259,22 @@ mod tests {
             [0, 0],
             "a first frame does not count"
         );
-        assert!(c.pooled(2000));
+        assert!(c.pooled(2000, 0));
         c.took(Duration::from_millis(8));
         assert_eq!(c.times.map(|t| t.len), [0, 1]);
         c.took(Duration::from_millis(1));
         assert_eq!(c.times.map(|t| t.len), [0, 1], "a time without a frame");
+        // Another kind of the same work (edges for triangles) starts over too.
+        run(&mut c, 2000, FIRST + 10, 8.0, 5.0);
+        assert!(!c.pooled);
+        assert!(!c.pooled(2000, 0));
+        c.took(Duration::from_millis(5));
+        assert!(
+            c.pooled(2000, 1),
+            "another kind: measured again, pool first"
+        );
+        assert_eq!(c.times.map(|t| t.len), [0, 0]);
+        c.took(Duration::from_millis(8));
         // A frame of no work and one of some are not alike.
         assert!(!super::similar(0, 3));
         assert!(super::similar(0, 0));

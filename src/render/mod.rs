@@ -212,8 +212,11 @@ impl Renderer {
     ///
     /// With [`Renderer::set_measured`], a frame worth the pool may still be drawn on
     /// the calling thread, if frames of this work have been faster there; the caller
-    /// then reports each frame's time ([`Renderer::frame_took`]).
-    pub fn plan_frame(&mut self, work: u64) {
+    /// then reports each frame's time ([`Renderer::frame_took`]). `kind` tells frames
+    /// of the same amount of work but drawn differently apart (any value that changes
+    /// with how the frame is drawn: edges or triangles, culling): each is measured
+    /// afresh.
+    pub fn plan_frame(&mut self, work: u64, kind: u64) {
         let on_pool = self
             .pool
             .as_ref()
@@ -223,7 +226,7 @@ impl Renderer {
         if self.frame_threads
             && self.pool.is_some()
             && let Some(choice) = &mut self.choice
-            && !choice.pooled(work)
+            && !choice.pooled(work, kind)
         {
             self.frame_threads = false;
             self.frame_bins = false;

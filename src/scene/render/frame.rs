@@ -1,6 +1,7 @@
 //! A scene's frame: the camera, the buffers the plan asks for, every object drawn in
 //! order, supersampling resolved.
 
+use std::hash::{DefaultHasher, Hash, Hasher};
 use std::time::{Duration, Instant};
 
 use glam::{Mat3, Mat4, Vec3};
@@ -139,6 +140,7 @@ impl SceneFrame {
         let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
         self.renderer.plan_frame(
             target.len() as u64 * side + crate::render::TRIANGLE_WORK * triangles as u64,
+            self.draw_kind(scene),
         );
         let start = Instant::now();
         match self.renderer.pool().cloned() {
@@ -148,6 +150,20 @@ impl SceneFrame {
             None => self.draw_here(scene, target, view),
         }
         self.renderer.frame_took(start.elapsed());
+    }
+
+    /// What tells frames of one amount of work apart for the renderer's measured
+    /// choice ([`Renderer::plan_frame`]): the interpolation and traversal, and what
+    /// each object draws (triangles, edges) and culls, which the viewer changes while
+    /// it runs.
+    fn draw_kind(&self, scene: &Scene) -> u64 {
+        let mut h = DefaultHasher::new();
+        (self.interpolation, self.traversal).hash(&mut h);
+        for o in &scene.objects {
+            let e = &o.desc.effects;
+            (e.fill, e.wireframe, e.cull).hash(&mut h);
+        }
+        h.finish()
     }
 
     /// [`SceneFrame::draw`] on the calling thread.
@@ -401,5 +417,38 @@ fn resolve(fine: &Rgba8, ft: Target, side: u32, out: &mut Rgba8, target: Target,
             }
             px[3] = ((covered * 255 + n / 2) / n) as u8;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SceneFrame;
+    use crate::raster::Traversal;
+    use crate::scene::{Mode, Scene};
+
+    /// Frames drawn differently have different kinds, so the measured choice starts
+    /// over when the viewer's `w` or `b` changes them; the same drawing keeps its kind.
+    #[test]
+    fn a_change_in_drawing_changes_the_kind() {
+        let mut scene = Scene::standard("teapot").expect("the built-in teapot");
+        let mut frame = SceneFrame::new(&scene);
+        let fill = frame.draw_kind(&scene);
+        assert_eq!(frame.draw_kind(&scene), fill);
+        let mut kinds = vec![fill];
+        for mode in [Mode::Wire, Mode::FillWire] {
+            scene.set_mode(mode);
+            kinds.push(frame.draw_kind(&scene));
+        }
+        scene.set_mode(Mode::Fill);
+        assert_eq!(frame.draw_kind(&scene), fill, "back to triangles");
+        scene.set_cull(true);
+        kinds.push(frame.draw_kind(&scene));
+        scene.set_cull(false);
+        frame.traversal = Traversal::Scalar;
+        kinds.push(frame.draw_kind(&scene));
+        let mut distinct = kinds.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        assert_eq!(distinct.len(), kinds.len(), "{kinds:?}");
     }
 }

@@ -211,27 +211,29 @@ impl App {
         if let (false, Some(fps)) = (self.paused, self.fps.fps()) {
             s.push(Priority::Drawing, format!("{fps:.0} fps"));
         }
-        s.push(
+        let threads = if frame.renderer.frame_pooled() {
+            format!("{} threads", frame.renderer.threads())
+        } else {
+            "1 thread".to_string()
+        };
+        s.push_short(
             Priority::Timing,
             format!(
-                "transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms, {}",
+                "transform {:.1} raster+shade {:.1} glyphs {:.1} output {:.1} ms, {threads}",
                 ms(tf),
                 ms(rs),
                 ms(self.viewport.glyph_time),
                 ms(self.output_time),
-                if frame.renderer.frame_pooled() {
-                    format!("{} threads", frame.renderer.threads())
-                } else {
-                    "1 thread".to_string()
-                }
             ),
+            format!("raster+shade {:.1} ms, {threads}", ms(rs)),
         );
-        s.push(
+        s.push_short(
             Priority::Counts,
             format!(
                 "tris {} drawn {} culled {} clipped",
                 stats.drawn, stats.culled, stats.clipped
             ),
+            format!("tris {}", stats.drawn),
         );
         s.push(Priority::Bytes, format!("{} B", self.bytes));
         let l = self.link;
@@ -239,19 +241,18 @@ impl App {
         match l.rtt {
             _ if l.unpaced => link.push_str(" unpaced (no answer)"),
             Some(rtt) => {
-                let _ = write!(
-                    link,
-                    " rtt {:.0} ms {:.0} fps delivered",
-                    ms(rtt),
-                    l.delivered_fps
-                );
+                let _ = write!(link, " rtt {:.0} ms", ms(rtt));
             }
             None => {}
+        }
+        let short = link.clone();
+        if let (false, Some(_)) = (l.unpaced, l.rtt) {
+            let _ = write!(link, " {:.0} fps delivered", l.delivered_fps);
         }
         if let Some(b) = l.budget {
             let _ = write!(link, " {:.1} kB/frame", b as f64 / 1e3);
         }
-        s.push(Priority::Link, link);
+        s.push_short(Priority::Link, link, short);
         s.push(Priority::Always, "? help");
         if !scene.is_model() {
             s.push(

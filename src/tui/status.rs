@@ -21,11 +21,27 @@ pub enum Priority {
     Timing,
 }
 
-/// Fields joined by ` | `, kept in their order; `fit` drops the least important until
-/// the line fits.
+/// Fields joined by ` | `, kept in their order; `fit` shortens, then drops, the least
+/// important until the line fits.
 #[derive(Debug, Default)]
 pub struct StatusLine {
-    fields: Vec<(Priority, String)>,
+    fields: Vec<Field>,
+}
+
+#[derive(Debug)]
+struct Field {
+    priority: Priority,
+    text: String,
+    /// A shorter form, taken before any field is dropped.
+    short: Option<String>,
+}
+
+/// What [`StatusLine::fit`] shows of a field.
+#[derive(Clone, Copy, PartialEq)]
+enum Shown {
+    Whole,
+    Short,
+    Dropped,
 }
 
 impl StatusLine {
@@ -34,41 +50,63 @@ impl StatusLine {
     }
 
     pub fn push(&mut self, p: Priority, text: impl Into<String>) {
-        self.fields.push((p, text.into()));
+        self.fields.push(Field {
+            priority: p,
+            text: text.into(),
+            short: None,
+        });
     }
 
-    /// The line in at most `width` characters: fields dropped from the least
-    /// important (the latest of equal importance first); if even the essential fields
-    /// do not fit, the line is cut.
+    /// [`StatusLine::push`] with a shorter form for a narrow terminal.
+    pub fn push_short(&mut self, p: Priority, text: impl Into<String>, short: impl Into<String>) {
+        self.fields.push(Field {
+            priority: p,
+            text: text.into(),
+            short: Some(short.into()),
+        });
+    }
+
+    /// The line in at most `width` characters: fields shortened, then dropped, from
+    /// the least important (the latest of equal importance first), so that every field
+    /// keeps its short form before any is dropped; if even the essential fields do not
+    /// fit, the line is cut.
     #[must_use]
     pub fn fit(&self, width: usize) -> String {
-        let mut keep: Vec<bool> = vec![true; self.fields.len()];
-        let len = |keep: &[bool]| -> usize {
-            let (n, chars) = self
-                .fields
-                .iter()
-                .zip(keep)
-                .filter(|(_, k)| **k)
-                .fold((0usize, 0usize), |(n, c), ((_, t), _)| {
-                    (n + 1, c + t.chars().count())
-                });
+        let mut shown = vec![Shown::Whole; self.fields.len()];
+        let text = |i: usize, shown: &[Shown]| -> Option<&str> {
+            let f = &self.fields[i];
+            match shown[i] {
+                Shown::Whole => Some(&f.text),
+                Shown::Short => f.short.as_deref(),
+                Shown::Dropped => None,
+            }
+        };
+        let len = |shown: &[Shown]| -> usize {
+            let (n, chars) = (0..self.fields.len())
+                .filter_map(|i| text(i, shown))
+                .fold((0usize, 0usize), |(n, c), t| (n + 1, c + t.chars().count()));
             chars + 3 * n.saturating_sub(1)
         };
-        while len(&keep) > width {
-            let drop = (0..self.fields.len())
-                .filter(|&i| keep[i] && self.fields[i].0 != Priority::Always)
-                .max_by_key(|&i| (self.fields[i].0, i));
-            match drop {
-                Some(i) => keep[i] = false,
-                None => break,
+        // The least important field (the latest of equal importance) that `can` change.
+        let least = |shown: &[Shown], can: &dyn Fn(usize, &[Shown]) -> bool| {
+            (0..self.fields.len())
+                .filter(|&i| self.fields[i].priority != Priority::Always && can(i, shown))
+                .max_by_key(|&i| (self.fields[i].priority, i))
+        };
+        let shortens =
+            |i: usize, shown: &[Shown]| shown[i] == Shown::Whole && self.fields[i].short.is_some();
+        let drops = |i: usize, shown: &[Shown]| shown[i] != Shown::Dropped;
+        while len(&shown) > width {
+            if let Some(i) = least(&shown, &shortens) {
+                shown[i] = Shown::Short;
+            } else if let Some(i) = least(&shown, &drops) {
+                shown[i] = Shown::Dropped;
+            } else {
+                break;
             }
         }
-        let line = self
-            .fields
-            .iter()
-            .zip(&keep)
-            .filter(|(_, k)| **k)
-            .map(|((_, t), _)| t.as_str())
+        let line = (0..self.fields.len())
+            .filter_map(|i| text(i, &shown))
             .collect::<Vec<_>>()
             .join(" | ");
         line.chars().take(width).collect()
@@ -146,6 +184,36 @@ mod tests {
         assert_eq!(s.fit(40), "inspect | blocks truecolor | ? help");
         // Too narrow even for the essentials: cut.
         assert_eq!(s.fit(10), "inspect | ");
+    }
+
+    /// Every field takes its short form before any is dropped, the least important
+    /// first.
+    #[test]
+    fn fields_are_shortened_before_any_is_dropped() {
+        let mut s = StatusLine::default();
+        s.push(Priority::Always, "blocks truecolor");
+        s.push(Priority::Drawing, "fill");
+        s.push_short(
+            Priority::Timing,
+            "transform 0.2 raster 1.0 ms, 2 threads",
+            "raster 1.0 ms, 2 threads",
+        );
+        s.push_short(Priority::Counts, "tris 992 drawn 0 culled", "tris 992");
+        s.push(Priority::Always, "? help");
+        let whole = "blocks truecolor | fill | transform 0.2 raster 1.0 ms, 2 threads | tris 992 drawn 0 culled | ? help";
+        assert_eq!(s.fit(200), whole);
+        assert_eq!(s.fit(whole.len()), whole);
+        assert_eq!(
+            s.fit(whole.len() - 1),
+            "blocks truecolor | fill | raster 1.0 ms, 2 threads | tris 992 drawn 0 culled | ? help"
+        );
+        assert_eq!(
+            s.fit(70),
+            "blocks truecolor | fill | raster 1.0 ms, 2 threads | tris 992 | ? help"
+        );
+        // Then the least important goes, whole.
+        assert_eq!(s.fit(69), "blocks truecolor | fill | tris 992 | ? help");
+        assert_eq!(s.fit(33), "blocks truecolor | fill | ? help");
     }
 
     #[test]

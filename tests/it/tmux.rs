@@ -332,7 +332,8 @@ fn fps_never_exceeds_the_cap() {
     t.assert_restored();
 }
 
-/// The status line's timings name the way the frame was drawn: on one thread here.
+/// The status line's timings name the way the frame was drawn (on one thread here),
+/// in their short form too once the terminal narrows.
 #[test]
 fn the_status_line_names_the_drawing_threads() {
     let Some(t) = Tmux::sized("threads", "sh", 260, 40) else {
@@ -341,6 +342,9 @@ fn the_status_line_names_the_drawing_threads() {
     };
     t.start_viewer_with("TERM=xterm-256color LANG=C.UTF-8", "--threads 1");
     let s = t.wait_until(|s| status(s).contains(" ms, "));
+    assert!(status(&s).contains(" ms, 1 thread |"), "{}", status(&s));
+    t.run(&["resize-window", "-t", "t", "-x", "140", "-y", "40"]);
+    let s = t.wait_until(|s| status(s).contains("| raster+shade "));
     assert!(status(&s).contains(" ms, 1 thread |"), "{}", status(&s));
     t.keys(&["q"]);
     t.assert_restored();

@@ -21,8 +21,8 @@ pub enum Priority {
     Timing,
 }
 
-/// Fields joined by ` | `, kept in their order; `fit` shortens, then drops, the least
-/// important until the line fits.
+/// Fields joined by ` | `, kept in their order; `fit` shortens them and leaves out the
+/// least important until the line fits.
 #[derive(Debug, Default)]
 pub struct StatusLine {
     fields: Vec<Field>,
@@ -66,13 +66,25 @@ impl StatusLine {
         });
     }
 
-    /// The line in at most `width` characters: fields shortened, then dropped, from
-    /// the least important (the latest of equal importance first), so that every field
-    /// keeps its short form before any is dropped; if even the essential fields do not
+    /// The line in at most `width` characters. Fields are left out from the least
+    /// important (the latest of equal importance first) until the line fits with every
+    /// field in its short form; then the fields kept are given their whole form, the
+    /// most important first, as far as they fit. If even the essential fields do not
     /// fit, the line is cut.
     #[must_use]
     pub fn fit(&self, width: usize) -> String {
-        let mut shown = vec![Shown::Whole; self.fields.len()];
+        let n = self.fields.len();
+        let mut shown: Vec<Shown> = self
+            .fields
+            .iter()
+            .map(|f| {
+                if f.short.is_some() {
+                    Shown::Short
+                } else {
+                    Shown::Whole
+                }
+            })
+            .collect();
         let text = |i: usize, shown: &[Shown]| -> Option<&str> {
             let f = &self.fields[i];
             match shown[i] {
@@ -82,27 +94,27 @@ impl StatusLine {
             }
         };
         let len = |shown: &[Shown]| -> usize {
-            let (n, chars) = (0..self.fields.len())
+            let (n, chars) = (0..n)
                 .filter_map(|i| text(i, shown))
                 .fold((0usize, 0usize), |(n, c), t| (n + 1, c + t.chars().count()));
             chars + 3 * n.saturating_sub(1)
         };
-        // The least important field (the latest of equal importance) that `can` change.
-        let least = |shown: &[Shown], can: &dyn Fn(usize, &[Shown]) -> bool| {
-            (0..self.fields.len())
-                .filter(|&i| self.fields[i].priority != Priority::Always && can(i, shown))
-                .max_by_key(|&i| (self.fields[i].priority, i))
-        };
-        let shortens =
-            |i: usize, shown: &[Shown]| shown[i] == Shown::Whole && self.fields[i].short.is_some();
-        let drops = |i: usize, shown: &[Shown]| shown[i] != Shown::Dropped;
-        while len(&shown) > width {
-            if let Some(i) = least(&shown, &shortens) {
-                shown[i] = Shown::Short;
-            } else if let Some(i) = least(&shown, &drops) {
-                shown[i] = Shown::Dropped;
-            } else {
+        let mut by_importance: Vec<usize> = (0..n).collect();
+        by_importance.sort_by_key(|&i| (self.fields[i].priority, i));
+        for &i in by_importance.iter().rev() {
+            if len(&shown) <= width {
                 break;
+            }
+            if self.fields[i].priority != Priority::Always {
+                shown[i] = Shown::Dropped;
+            }
+        }
+        for &i in &by_importance {
+            if shown[i] == Shown::Short {
+                shown[i] = Shown::Whole;
+                if len(&shown) > width {
+                    shown[i] = Shown::Short;
+                }
             }
         }
         let line = (0..self.fields.len())
@@ -161,6 +173,8 @@ impl FpsMeter {
 
 #[cfg(test)]
 mod tests {
+    use proptest::prelude::*;
+
     use super::*;
 
     #[test]
@@ -186,8 +200,8 @@ mod tests {
         assert_eq!(s.fit(10), "inspect | ");
     }
 
-    /// Every field takes its short form before any is dropped, the least important
-    /// first.
+    /// Every field takes its short form before any is left out; the room left is
+    /// given back to the most important.
     #[test]
     fn fields_are_shortened_before_any_is_dropped() {
         let mut s = StatusLine::default();
@@ -211,9 +225,80 @@ mod tests {
             s.fit(70),
             "blocks truecolor | fill | raster 1.0 ms, 2 threads | tris 992 | ? help"
         );
-        // Then the least important goes, whole.
-        assert_eq!(s.fit(69), "blocks truecolor | fill | tris 992 | ? help");
-        assert_eq!(s.fit(33), "blocks truecolor | fill | ? help");
+        // Then the least important goes, and the room it leaves goes to the others.
+        assert_eq!(
+            s.fit(69),
+            "blocks truecolor | fill | tris 992 drawn 0 culled | ? help"
+        );
+        assert_eq!(s.fit(42), "blocks truecolor | fill | ? help");
+    }
+
+    fn priority() -> impl Strategy<Value = Priority> {
+        prop_oneof![
+            Just(Priority::Always),
+            Just(Priority::Drawing),
+            Just(Priority::Link),
+            Just(Priority::Bytes),
+            Just(Priority::Counts),
+            Just(Priority::Timing),
+        ]
+    }
+
+    proptest! {
+        /// Whatever the fields and width: the line fits; the essential fields are all
+        /// there when they fit alone; a field is left out only after every less
+        /// important one; each field shows one of its forms.
+        #[test]
+        fn a_fitted_line_fits_and_leaves_out_the_least_important(
+            fields in prop::collection::vec((priority(), "[a-z]{1,12}", prop::option::of("[A-Z]{1,5}")), 0..8),
+            width in 0usize..80,
+        ) {
+            // Each text names its field: an index added, short forms upper case.
+            let fields: Vec<(Priority, String, Option<String>)> = fields
+                .into_iter()
+                .enumerate()
+                .map(|(i, (p, t, short))| (p, format!("{t}{i}"), short.map(|s| format!("{s}{i}"))))
+                .collect();
+            let mut s = StatusLine::default();
+            for (p, text, short) in &fields {
+                match short {
+                    Some(short) => s.push_short(*p, text.clone(), short.clone()),
+                    None => s.push(*p, text.clone()),
+                }
+            }
+            let line = s.fit(width);
+            prop_assert!(line.chars().count() <= width);
+            let essential: Vec<&str> = fields
+                .iter()
+                .filter(|f| f.0 == Priority::Always)
+                .map(|f| f.1.as_str())
+                .collect();
+            if essential.join(" | ").len() > width {
+                return Ok(());
+            }
+            let parts: Vec<&str> = if line.is_empty() { vec![] } else { line.split(" | ").collect() };
+            let mut next = 0;
+            let mut kept = vec![false; fields.len()];
+            for part in &parts {
+                let found = (next..fields.len()).find(|&i| {
+                    fields[i].1 == *part || fields[i].2.as_deref() == Some(*part)
+                });
+                prop_assert!(found.is_some(), "{part:?} in {line:?}");
+                let i = found.unwrap();
+                kept[i] = true;
+                next = i + 1;
+            }
+            for (i, f) in fields.iter().enumerate() {
+                if f.0 == Priority::Always {
+                    prop_assert!(kept[i], "{line:?} lacks {:?}", f.1);
+                }
+                for (j, g) in fields.iter().enumerate() {
+                    if !kept[i] && kept[j] && g.0 != Priority::Always {
+                        prop_assert!((f.0, i) > (g.0, j), "{:?} left out before {:?}: {line:?}", f.1, g.1);
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -1,5 +1,6 @@
-//! The status line: fields in order of importance, the less important dropped first
-//! when the terminal is narrow, and the frame rate measured over recent frames.
+//! The status line: fields in order of importance, shortened and then the less
+//! important left out when the terminal is narrow, and the frame rate measured over
+//! recent frames.
 
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
@@ -57,12 +58,15 @@ impl StatusLine {
         });
     }
 
-    /// [`StatusLine::push`] with a shorter form for a narrow terminal.
+    /// [`StatusLine::push`] with a shorter form for a narrow terminal (ignored unless
+    /// it is shorter).
     pub fn push_short(&mut self, p: Priority, text: impl Into<String>, short: impl Into<String>) {
+        let (text, short) = (text.into(), short.into());
+        let shorter = short.chars().count() < text.chars().count();
         self.fields.push(Field {
             priority: p,
-            text: text.into(),
-            short: Some(short.into()),
+            text,
+            short: shorter.then_some(short),
         });
     }
 
@@ -231,6 +235,12 @@ mod tests {
             "blocks truecolor | fill | tris 992 drawn 0 culled | ? help"
         );
         assert_eq!(s.fit(42), "blocks truecolor | fill | ? help");
+        // A "short" form longer than the whole one is never taken.
+        let mut s = StatusLine::default();
+        for text in ["aaa", "bbb", "ccc"] {
+            s.push_short(Priority::Always, text, "LONGER");
+        }
+        assert_eq!(s.fit(15), "aaa | bbb | ccc");
     }
 
     fn priority() -> impl Strategy<Value = Priority> {
@@ -287,6 +297,32 @@ mod tests {
                 let i = found.unwrap();
                 kept[i] = true;
                 next = i + 1;
+            }
+            let whole = fields.iter().map(|f| f.1.as_str()).collect::<Vec<_>>().join(" | ");
+            if whole.chars().count() <= width {
+                prop_assert_eq!(&line, &whole, "the whole line fits");
+            }
+            // A field left in its short form could not have had its whole form.
+            let width_of = |t: &str| t.chars().count();
+            for part in &parts {
+                if let Some(f) = fields.iter().find(|f| f.2.as_deref() == Some(*part)) {
+                    prop_assert!(
+                        width_of(&line) - width_of(part) + width_of(&f.1) > width,
+                        "{:?} could be whole in {line:?}", f.1
+                    );
+                }
+            }
+            // The most important field left out did not fit even with every kept field
+            // in its shortest form.
+            let shortest = |f: &(Priority, String, Option<String>)| {
+                f.2.as_deref().filter(|s| s.len() < f.1.len()).map_or(f.1.len(), str::len)
+            };
+            let left_out = (0..fields.len()).filter(|&i| !kept[i]).min_by_key(|&i| (fields[i].0, i));
+            if let Some(i) = left_out {
+                let with: Vec<usize> = (0..fields.len()).filter(|&j| kept[j] || j == i).collect();
+                let len: usize = with.iter().map(|&j| shortest(&fields[j])).sum::<usize>()
+                    + 3 * (with.len() - 1);
+                prop_assert!(len > width, "{:?} left out of {line:?}", fields[i].1);
             }
             for (i, f) in fields.iter().enumerate() {
                 if f.0 == Priority::Always {

@@ -154,8 +154,7 @@ impl SceneFrame {
 
     /// What tells frames of one amount of work apart for the renderer's measured
     /// choice ([`Renderer::plan_frame`]): the interpolation and traversal, and what
-    /// each object draws (triangles, edges) and culls, which the viewer changes while
-    /// it runs.
+    /// each object draws (triangles, edges) and culls (the viewer's `w` and `b`).
     fn draw_kind(&self, scene: &Scene) -> u64 {
         let mut h = DefaultHasher::new();
         (self.interpolation, self.traversal).hash(&mut h);

@@ -173,7 +173,12 @@ fn the_status_line_names_the_drawing_threads() {
     assert!(status(&s).contains(" ms, 1 thread |"), "{}", status(&s));
     t.run(&["resize-window", "-t", "t", "-x", "140", "-y", "40"]);
     let s = t.wait_until(|s| status(s).contains("| raster+shade "));
-    assert!(status(&s).contains(" ms, 1 thread |"), "{}", status(&s));
+    let line = status(&s);
+    assert!(
+        line.contains("| raster+shade ") && !line.contains("transform"),
+        "{line}"
+    );
+    assert!(line.contains(" ms, 1 thread |"), "{line}");
     t.keys(&["q"]);
     t.assert_restored();
 }

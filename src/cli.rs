@@ -200,8 +200,11 @@ pub fn main() -> ExitCode {
         Some(Command::Line(args)) => {
             line_cmd::run(&args, &mut io::stdout().lock()).map_err(Into::into)
         }
-        Some(Command::Bench(BenchCommand::Render(args))) => render_cmd::bench_render(&args)
-            .and_then(|r| writeln!(io::stdout(), "{r}").map_err(Into::into)),
+        Some(Command::Bench(BenchCommand::Render(args))) => match &args.compare {
+            Some(counts) => render_cmd::bench_compare(&args, counts, &mut io::stdout().lock()),
+            None => render_cmd::bench_render(&args)
+                .and_then(|r| writeln!(io::stdout(), "{r}").map_err(Into::into)),
+        },
         Some(Command::Bench(BenchCommand::Accuracy(args))) => {
             accuracy_cmd::run_cmd(&args, &mut io::stdout().lock())
         }

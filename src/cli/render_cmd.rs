@@ -53,15 +53,18 @@ impl SceneArgs {
         super::view_cmd::load(&self.model, self.mode, self.cull)
     }
 
-    /// The buffers and pipelines for `scene`, with `--interpolation` and
-    /// `--traversal`.
+    /// The buffers and pipelines for `scene`, with `--interpolation`, `--traversal`
+    /// and `--threads`.
     fn frame(&self, scene: &Scene) -> SceneFrame {
+        self.frame_on(scene, self.threads)
+    }
+
+    /// [`SceneArgs::frame`] on `threads` threads (the machine's cores when not given).
+    fn frame_on(&self, scene: &Scene, threads: Option<usize>) -> SceneFrame {
         let mut frame = SceneFrame::new(scene);
         frame.interpolation = self.interpolation;
         frame.traversal = self.traversal;
-        frame
-            .renderer
-            .set_threads(super::threads_or_cores(self.threads));
+        frame.renderer.set_threads(super::threads_or_cores(threads));
         frame
     }
 }
@@ -125,6 +128,15 @@ pub struct BenchRenderArgs {
     /// been faster on, as the viewer does (by default every frame uses the threads).
     #[arg(long)]
     pub measured: bool,
+    /// Thread counts to compare in one run, e.g. `1,2`: each round draws `--frames`
+    /// frames with each count in turn, back to back, so a machine's slow spells hit
+    /// them alike; prints each round and each count's speed-up over the first (the
+    /// median of the rounds' ratios).
+    #[arg(long, value_delimiter = ',', value_parser = super::parse_threads, conflicts_with = "threads")]
+    pub compare: Option<Vec<usize>>,
+    /// Rounds of `--compare`.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100), requires = "compare")]
+    pub rounds: u32,
 }
 
 /// Refuses an `--out` path that is not a PNG, before anything is rendered or created
@@ -295,6 +307,14 @@ impl std::fmt::Display for BenchReport {
 /// Runs the standard benchmark: the model's default scene seen from the fixed
 /// camera ([`Scene::standard`]), turning; colour and depth cleared and drawn per frame.
 pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliError> {
+    let scene = bench_scene(args)?;
+    let mut frame = bench_frame(args, &scene, args.scene.threads);
+    let (times, covered) = time_frames(args, &scene, &mut frame);
+    Ok(report(&scene, &frame, &times, covered))
+}
+
+/// The benchmark's scene: the model's default scene in `--mode`, culled with `--cull`.
+fn bench_scene(args: &BenchRenderArgs) -> Result<Scene, super::CliError> {
     if is_scene_path(&args.scene.model) {
         return Err(super::CliError::Usage(format!(
             "{0}: bench render times a model (`teapot`, `bunny`, `sphere:N` or a model file), \
@@ -306,12 +326,23 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
     super::view_cmd::print_warnings(&scene.warnings, &mut std::io::stderr().lock());
     scene.set_mode(args.scene.mode);
     scene.set_cull(args.scene.cull);
-    let target = args.size;
-    let mut frame = args.scene.frame(&scene);
+    Ok(scene)
+}
+
+/// The buffers and pipelines for the benchmark on `threads` threads (the machine's
+/// cores when not given), with `--isa` and `--measured`.
+fn bench_frame(args: &BenchRenderArgs, scene: &Scene, threads: Option<usize>) -> SceneFrame {
+    let mut frame = args.scene.frame_on(scene, threads);
     if let Some(isa) = args.isa {
         frame.renderer.isa = isa;
     }
     frame.renderer.set_measured(args.measured);
+    frame
+}
+
+/// Draws `--frames` frames (at least one), each after `--pause-ms`; returns each
+/// frame's time in ms, sorted, and the mean covered fragments per frame.
+fn time_frames(args: &BenchRenderArgs, scene: &Scene, frame: &mut SceneFrame) -> (Vec<f64>, u64) {
     let pause = std::time::Duration::from_millis(args.pause_ms);
     let frames = args.frames.max(1);
     let mut times = Vec::with_capacity(frames as usize);
@@ -327,7 +358,7 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
                 std::thread::sleep(pause);
             }
             let start = Instant::now();
-            frame.draw(&scene, target, &view);
+            frame.draw(scene, args.size, &view);
             times.push(start.elapsed().as_secs_f64() * 1e3);
             covered += frame.stats.fragments;
         }
@@ -339,13 +370,67 @@ pub fn bench_render(args: &BenchRenderArgs) -> Result<BenchReport, super::CliErr
         None => run(),
     }
     times.sort_by(f64::total_cmp);
+    (times, covered / u64::from(frames))
+}
+
+/// The report of frames drawn by `frame`, their times sorted.
+fn report(scene: &Scene, frame: &SceneFrame, times: &[f64], covered_px: u64) -> BenchReport {
     let opts = frame.draw_options(&scene.plan.objects[0]);
-    Ok(BenchReport {
+    BenchReport {
         median_ms: times[times.len() / 2],
         min_ms: times[0],
         triangles: scene.objects[0].mesh.triangle_count(),
-        covered_px: covered / u64::from(frames),
+        covered_px,
         isa: frame.renderer.copy_for::<Lambert<'_>>(&opts).isa,
         threads: frame.renderer.threads(),
-    })
+    }
+}
+
+/// `bench render --compare`: the standard benchmark with each thread count in turn,
+/// `--rounds` times; writes each round and then the summary to `out`.
+pub fn bench_compare(
+    args: &BenchRenderArgs,
+    counts: &[usize],
+    out: &mut impl Write,
+) -> Result<(), super::CliError> {
+    let scene = bench_scene(args)?;
+    let mut frames: Vec<SceneFrame> = counts
+        .iter()
+        .map(|&t| bench_frame(args, &scene, Some(t)))
+        .collect();
+    // Per count, each round's median.
+    let mut medians = vec![Vec::new(); counts.len()];
+    for round in 1..=args.rounds {
+        let mut line = format!("round {round}:");
+        for (k, frame) in frames.iter_mut().enumerate() {
+            let (times, covered) = time_frames(args, &scene, frame);
+            let r = report(&scene, frame, &times, covered);
+            medians[k].push(r.median_ms);
+            line.push_str(&format!(
+                " threads={} median_ms={:.3}",
+                r.threads, r.median_ms
+            ));
+            if k > 0 {
+                line.push_str(&format!(
+                    " ({:.2}x)",
+                    medians[0][medians[0].len() - 1] / r.median_ms
+                ));
+            }
+        }
+        writeln!(out, "{line}")?;
+    }
+    let mut line = String::from("all:");
+    for (k, m) in medians.iter().enumerate() {
+        let (lo, hi) = m
+            .iter()
+            .fold((f64::INFINITY, 0f64), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        line.push_str(&format!(" threads={} median_ms={lo:.3}-{hi:.3}", counts[k]));
+        if k > 0 {
+            let mut ratios: Vec<f64> = medians[0].iter().zip(m).map(|(a, b)| a / b).collect();
+            ratios.sort_by(f64::total_cmp);
+            line.push_str(&format!(" speedup={:.2}x", ratios[ratios.len() / 2]));
+        }
+    }
+    writeln!(out, "{line}")?;
+    Ok(())
 }

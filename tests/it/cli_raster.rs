@@ -263,3 +263,65 @@ fn bench_render_reports_and_checks_its_instruction_set() {
         assert!(!ok && err.contains("cannot run"), "{err}");
     }
 }
+
+/// `bench render --compare` draws with each thread count in turn, round by round, and
+/// sums up each count's medians and its speed-up over the first; it refuses
+/// `--threads` beside it and `--rounds` without it.
+#[test]
+fn bench_render_compares_thread_counts_round_by_round() {
+    let (ok, out, err) = termrast(&[
+        "bench",
+        "render",
+        "teapot",
+        "--size",
+        "96x64",
+        "--frames",
+        "2",
+        "--compare",
+        "1,2,3",
+        "--rounds",
+        "2",
+    ]);
+    assert!(ok, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 3, "{out}");
+    let medians = |line: &str| -> Vec<(usize, f64)> {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        words
+            .windows(2)
+            .filter_map(|w| {
+                let t = w[0].strip_prefix("threads=")?.parse().ok()?;
+                let m = w[1].strip_prefix("median_ms=")?;
+                Some((t, m.split('-').next()?.parse().ok()?))
+            })
+            .collect()
+    };
+    for (r, line) in lines[..2].iter().enumerate() {
+        assert!(line.starts_with(&format!("round {}:", r + 1)), "{line}");
+        let m = medians(line);
+        assert_eq!(
+            m.iter().map(|m| m.0).collect::<Vec<_>>(),
+            [1, 2, 3],
+            "{line}"
+        );
+        assert!(m.iter().all(|m| m.1 > 0.0), "{line}");
+        assert_eq!(
+            line.matches("x)").count(),
+            2,
+            "a ratio per later count: {line}"
+        );
+    }
+    let all = lines[2];
+    assert!(all.starts_with("all:"), "{all}");
+    assert_eq!(medians(all).len(), 3, "{all}");
+    let speedups: Vec<f64> = all
+        .split_whitespace()
+        .filter_map(|w| w.strip_prefix("speedup=")?.strip_suffix('x')?.parse().ok())
+        .collect();
+    assert_eq!(speedups.len(), 2, "{all}");
+    assert!(speedups.iter().all(|&s| s > 0.0 && s.is_finite()), "{all}");
+    let (ok, _, err) = termrast(&["bench", "render", "--compare", "1,2", "--threads", "2"]);
+    assert!(!ok && err.contains("--threads"), "{err}");
+    let (ok, _, err) = termrast(&["bench", "render", "--rounds", "2"]);
+    assert!(!ok && err.contains("--compare"), "{err}");
+}

@@ -126,9 +126,13 @@ pub struct Renderer {
 pub const FUSED_PROJECTION_VERTICES: usize = 1 << 16;
 
 /// The default [`Renderer::min_parallel_vertices`]: a smaller mesh's vertex stage (the
-/// bunny's 1 839 vertices take a few microseconds) is done sooner by the calling thread
-/// than handed to a sleeping one and waited for; the draw then projects them.
+/// bunny's 1 839 vertices take a few microseconds) is not split by rayon, which would
+/// make the calling thread wait for a sleeping one, but shared in pieces the calling
+/// thread takes too (from [`MIN_CLAIMED_VERTICES`]; on a steady frame).
 pub const MIN_PARALLEL_VERTICES: usize = 1 << 12;
+
+/// The fewest vertices whose vertex stage is shared out in claimed pieces: two pieces.
+pub const MIN_CLAIMED_VERTICES: usize = 2 * tiles::VERTEX_JOB;
 
 /// Pixels a triangle's share of a draw is worth, for [`Renderer::min_threaded_work`]:
 /// set-up and binning, which many small triangles make the larger part.
@@ -283,9 +287,11 @@ impl Renderer {
 
     /// [`transform_projected`] for the renderer's target, on its threads (the same
     /// vertices, in chunks of the vertex array): the draws that follow use the
-    /// projections instead of making their own. On one thread (or for fewer than
-    /// [`Renderer::min_parallel_vertices`]), a mesh of fewer than
-    /// [`FUSED_PROJECTION_VERTICES`] is only transformed.
+    /// projections instead of making their own. Fewer than
+    /// [`Renderer::min_parallel_vertices`] are shared in pieces the calling thread
+    /// claims too (on a steady frame, from [`MIN_CLAIMED_VERTICES`]). On one thread (or
+    /// for fewer vertices), a mesh of fewer than [`FUSED_PROJECTION_VERTICES`] is only
+    /// transformed.
     pub fn transform<S: Shader>(
         &self,
         shader: &S,
@@ -293,6 +299,15 @@ impl Renderer {
         cache: &mut VertexCache<S::Varying>,
     ) {
         let target = self.target;
+        // A small mesh on the threads: in pieces the calling thread takes too, so a
+        // sleeping helper never holds it up.
+        if let Some(pool) = self.pool()
+            && vertex_count < self.min_parallel_vertices
+            && vertex_count >= MIN_CLAIMED_VERTICES
+            && pool.install(|| tiles::transform_claimed(shader, vertex_count, cache, target))
+        {
+            return;
+        }
         let pool = self
             .pool()
             .filter(|_| vertex_count >= self.min_parallel_vertices);

@@ -53,6 +53,7 @@ use crate::simd::{I32s, prefetch};
 use queue::plan_bands;
 use strips::StripPlan;
 use vertices::projections;
+pub(super) use vertices::transform_claimed;
 
 mod bins;
 mod queue;

@@ -402,6 +402,7 @@ pub fn bench_compare(
     let mut medians = vec![Vec::new(); counts.len()];
     for round in 1..=args.rounds {
         let mut line = format!("round {round}:");
+        let mut first = None;
         for (k, frame) in frames.iter_mut().enumerate() {
             let (times, covered) = time_frames(args, &scene, frame);
             let r = report(&scene, frame, &times, covered);
@@ -410,11 +411,9 @@ pub fn bench_compare(
                 " threads={} median_ms={:.3}",
                 r.threads, r.median_ms
             ));
-            if k > 0 {
-                line.push_str(&format!(
-                    " ({:.2}x)",
-                    medians[0][medians[0].len() - 1] / r.median_ms
-                ));
+            match first {
+                None => first = Some(r.median_ms),
+                Some(f) => line.push_str(&format!(" ({:.2}x)", f / r.median_ms)),
             }
         }
         writeln!(out, "{line}")?;

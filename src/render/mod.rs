@@ -342,9 +342,7 @@ impl Renderer {
                 .enumerate()
                 .for_each(|(k, (verts, out))| {
                     if !fresh {
-                        for (j, v) in verts.iter_mut().enumerate() {
-                            *v = vertex(k * tiles::VERTEX_JOB + j);
-                        }
+                        prepare::transform_in_place(shader, k * tiles::VERTEX_JOB, verts);
                     }
                     prepare::project_into(verts, target, out);
                 });

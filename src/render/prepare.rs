@@ -106,6 +106,19 @@ pub(crate) fn clip_vertex<S: Shader>(shader: &S, i: usize) -> ClipVertex<S::Vary
     ClipVertex { pos, var }
 }
 
+/// Vertices `first..first + verts.len()` through `shader`'s vertex stage, into the
+/// last frame's `verts` in place: a piece of a steady frame's parallel vertex stage.
+#[inline(always)]
+pub(crate) fn transform_in_place<S: Shader>(
+    shader: &S,
+    first: usize,
+    verts: &mut [ClipVertex<S::Varying>],
+) {
+    for (j, v) in verts.iter_mut().enumerate() {
+        *v = clip_vertex(shader, first + j);
+    }
+}
+
 /// [`transform`] and [`project_vertices`] for `target` in one pass: each block of
 /// vertices is projected while it is in the L1 cache, instead of being read back from
 /// memory once a large mesh has pushed it out of the processor's caches (a

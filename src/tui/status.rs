@@ -121,7 +121,7 @@ impl StatusLine {
                 }
             }
         }
-        let line = (0..self.fields.len())
+        let line = (0..n)
             .filter_map(|i| text(i, &shown))
             .collect::<Vec<_>>()
             .join(" | ");

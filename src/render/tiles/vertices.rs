@@ -9,7 +9,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use super::VERTEX_JOB;
 use super::queue::lock;
 use crate::raster::Target;
-use crate::render::prepare::{Projected, VertexCache, clip_vertex, one_per_vertex, project_into};
+use crate::render::prepare::{
+    Projected, VertexCache, one_per_vertex, project_into, transform_in_place,
+};
 use crate::render::shader::Shader;
 
 /// The most pieces [`project_claimed`] cuts the vertices into.
@@ -66,9 +68,7 @@ pub(in crate::render) fn transform_claimed<S: Shader>(
         .chunks_mut(piece)
         .zip(projected.chunks_mut(piece));
     claimed(pieces, |k, (verts, out)| {
-        for (j, v) in verts.iter_mut().enumerate() {
-            *v = clip_vertex(shader, k * piece + j);
-        }
+        transform_in_place(shader, k * piece, verts);
         project_into(verts, target, out);
     });
     cache.projected_for = Some(target);

@@ -154,8 +154,13 @@ impl Scratch {
         let bins = self.bins[i]
             .downcast_mut::<Bins<V>>()
             .expect("the entry's type was just checked");
-        bins.chunks.resize_with(chunks, Chunk::default);
-        for c in &mut bins.chunks {
+        // Grown, never shrunk: a frame's draws need different counts (a mesh of fewer
+        // triangles than chunks), and a dropped chunk's records would be allocated
+        // again by the next draw.
+        if bins.chunks.len() < chunks {
+            bins.chunks.resize_with(chunks, Chunk::default);
+        }
+        for c in &mut bins.chunks[..chunks] {
             c.starts.resize(bands + 1, 0);
             c.cost.resize(bands, 0);
         }

@@ -1,0 +1,145 @@
+//! A steady frame allocates nothing: after a few frames at a size, drawing more of
+//! them (the model turning, as in the viewer) makes no heap allocation on any thread,
+//! on one thread and on several, binned and in strips, for models and for a scene
+//! whose draws differ in size.
+//!
+//! Its own test binary: the allocator counts every thread's allocations, which other
+//! tests running at the same time would add to.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering::Relaxed};
+
+use termrast::raster::Target;
+use termrast::render::Spread;
+use termrast::scene::Scene;
+use termrast::scene::render::{SceneFrame, SceneView};
+
+/// The system allocator, counting the allocations made while [`ARMED`].
+struct Counting;
+
+static ARMED: AtomicBool = AtomicBool::new(false);
+static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+
+impl Counting {
+    fn count(&self) {
+        if ARMED.load(Relaxed) {
+            ALLOCATIONS.fetch_add(1, Relaxed);
+        }
+    }
+}
+
+// SAFETY: every call is passed on to `System` unchanged.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        self.count();
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        self.count();
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        self.count();
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations while drawing six frames of `scene` with `frame` once it is steady:
+/// after two frames in a row that allocated nothing (within 40). Buffers whose size
+/// follows the view (a bin's entries as the model turns) may still grow in the first
+/// frames, by doubling; a frame that allocates every time never becomes steady.
+fn allocations(frame: &mut SceneFrame, scene: &Scene, target: Target) -> u64 {
+    let mut k = 0;
+    let mut draw = || {
+        let view = SceneView {
+            yaw: 0.05 * k as f32,
+            ..SceneView::default()
+        };
+        k += 1;
+        ALLOCATIONS.store(0, Relaxed);
+        ARMED.store(true, Relaxed);
+        match frame.renderer.thread_pool().cloned() {
+            Some(pool) => pool.install(|| frame.draw(scene, target, &view)),
+            None => frame.draw(scene, target, &view),
+        }
+        ARMED.store(false, Relaxed);
+        ALLOCATIONS.load(Relaxed)
+    };
+    let mut quiet = 0;
+    for _ in 0..40 {
+        quiet = if draw() == 0 { quiet + 1 } else { 0 };
+        if quiet == 2 {
+            break;
+        }
+    }
+    (0..6).map(|_| draw()).sum()
+}
+
+/// A scene of the teapot and a quad of two triangles: draws of the same varyings with
+/// fewer triangles than a large pool's chunks and with more.
+fn teapot_and_quad(dir: &std::path::Path) -> Scene {
+    let quad = dir.join("quad.obj");
+    std::fs::write(
+        &quad,
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .expect("the quad is written");
+    let toml = dir.join("two.toml");
+    std::fs::write(
+        &toml,
+        "[[object]]\nmodel = \"teapot\"\n[object.effects]\ndepth_test = true\n\n\
+         [[object]]\nmodel = \"quad.obj\"\nscale = 0.4\n[object.effects]\ndepth_test = true\n",
+    )
+    .expect("the scene is written");
+    Scene::load(&toml).expect("the scene loads")
+}
+
+#[test]
+fn steady_frames_allocate_nothing() {
+    let dir = std::env::temp_dir().join(format!("termrast-alloc-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let scenes = [
+        ("teapot", Scene::standard("teapot").expect("built in")),
+        ("bunny", Scene::standard("bunny").expect("built in")),
+        (
+            "sphere:20000",
+            Scene::standard("sphere:20000").expect("built in"),
+        ),
+        ("teapot and quad", teapot_and_quad(&dir)),
+    ];
+    for (name, scene) in &scenes {
+        for target in [Target::new(400, 240), Target::new(1280, 720)] {
+            for threads in [1, 2, 4] {
+                let ways: &[Option<Spread>] = if threads == 1 {
+                    &[None]
+                } else {
+                    &[None, Some(Spread::Bins), Some(Spread::Strips)]
+                };
+                for &way in ways {
+                    let mut frame = SceneFrame::new(scene);
+                    frame.renderer.set_threads(threads);
+                    match way {
+                        Some(Spread::Bins) => frame.renderer.min_threaded_work = 0,
+                        Some(_) => {
+                            frame.renderer.min_threaded_work = u64::MAX;
+                            frame.renderer.min_strip_work = 0;
+                        }
+                        None => {}
+                    }
+                    let n = allocations(&mut frame, scene, target);
+                    assert_eq!(n, 0, "{name}, {target:?}, {threads} threads, {way:?}");
+                    if let Some(way) = way {
+                        assert_eq!(frame.renderer.spread(), way, "{name} {target:?}");
+                    }
+                }
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

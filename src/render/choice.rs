@@ -279,4 +279,32 @@ mod tests {
         assert!(!super::similar(0, 3));
         assert!(super::similar(0, 0));
     }
+
+    /// A renderer given another thread count measures both ways again: its times
+    /// were for the old pool.
+    #[test]
+    fn a_new_thread_count_measures_afresh() {
+        use crate::raster::Target;
+        use crate::render::Renderer;
+
+        let mut r = Renderer::new(Target::new(64, 64));
+        r.set_threads(2);
+        r.min_threaded_work = 0;
+        r.set_measured(true);
+        let frame = |r: &mut Renderer| {
+            r.plan_frame(100, 0);
+            let pooled = r.pool().is_some();
+            // The calling thread much faster.
+            r.frame_took(Duration::from_millis(if pooled { 8 } else { 1 }));
+            pooled
+        };
+        for _ in 0..FIRST {
+            frame(&mut r);
+        }
+        assert!(!frame(&mut r), "the calling thread chosen");
+        r.set_threads(3);
+        let again: Vec<bool> = (0..FIRST).map(|_| frame(&mut r)).collect();
+        let pool_then_one: Vec<bool> = (0..FIRST).map(|n| n < PROBE_FRAMES).collect();
+        assert_eq!(again, pool_then_one);
+    }
 }

@@ -189,6 +189,10 @@ impl Renderer {
         if threads == self.threads() {
             return;
         }
+        // Times measured with the old pool say nothing about the new one.
+        if self.choice.is_some() {
+            self.set_measured(true);
+        }
         self.pool = (threads > 1)
             .then(|| {
                 rayon::ThreadPoolBuilder::new()
@@ -497,16 +501,8 @@ impl Renderer {
             PieceWalker::<S, C, L, V, _>::new(shader, &mut self.depth, color, opts, target);
         let n = (indices.len() / 3) as u32;
         for t in 0..n {
-            walker.stats.triangles += 1;
-            let pv = Some(pv);
-            match prepare_projected(cache, pv, indices, t, target, opts, &mut walker) {
-                PrepareOutcome::Rejected => walker.stats.rejected += 1,
-                PrepareOutcome::Culled => walker.stats.culled += 1,
-                PrepareOutcome::Drawn { clipped } => {
-                    walker.stats.drawn += 1;
-                    walker.stats.clipped += u64::from(clipped);
-                }
-            }
+            let outcome = prepare_projected(cache, Some(pv), indices, t, target, opts, &mut walker);
+            outcome.count(&mut walker.stats, 1);
         }
         self.stats += walker.stats;
         self.projected = projected;

@@ -7,7 +7,7 @@ use std::ops::{Add, Mul, Sub};
 
 use glam::Vec4;
 
-use super::options::{Cull, DrawOptions};
+use super::options::{Cull, DrawOptions, DrawStats};
 use super::shader::Shader;
 use crate::raster::clip::{
     ClipOutcome, ClipVertex, classify_codes, clip_straddling, guard_band_ndc, outcode,
@@ -88,6 +88,24 @@ pub enum PrepareOutcome {
     Rejected,
     Culled,
     Drawn { clipped: bool },
+}
+
+impl PrepareOutcome {
+    /// Counts the triangle in `stats`, `n` times: 1, or 0 or 1 for the strips, which
+    /// count a triangle only in the strip that owns it, without a branch (see
+    /// `tiles::strips`).
+    #[inline(always)]
+    pub fn count(self, stats: &mut DrawStats, n: u64) {
+        stats.triangles += n;
+        match self {
+            PrepareOutcome::Rejected => stats.rejected += n,
+            PrepareOutcome::Culled => stats.culled += n,
+            PrepareOutcome::Drawn { clipped } => {
+                stats.drawn += n;
+                stats.clipped += n * u64::from(clipped);
+            }
+        }
+    }
 }
 
 /// Transforms every vertex once into the cache.

@@ -6,7 +6,7 @@ use std::ops::Range;
 use super::Job;
 use crate::raster::Setup;
 use crate::render::options::DrawStats;
-use crate::render::prepare::{EmitPiece, PrepareOutcome, Prepared, prepare_projected};
+use crate::render::prepare::{EmitPiece, Prepared, prepare_projected};
 use crate::render::shader::Shader;
 
 /// What a piece costs the walk of a band besides its pixels, in pixels (the walk's
@@ -70,7 +70,7 @@ impl<V: Copy> EmitPiece<V> for Binner<'_, V> {
         // A box of at most four pixels covering none of them (most triangles of a mesh
         // far denser than the pixels) would be walked for nothing: it is not stored.
         // The stale depth tiles the walk would have filled read as cleared anyway.
-        if b.width() * b.height() <= 4 && !covers_any(&p.setup) {
+        if u64::from(b.width()) * u64::from(b.height()) <= 4 && !covers_any(&p.setup) {
             return;
         }
         let c = &mut *self.chunk;
@@ -129,16 +129,9 @@ pub(in crate::render) fn setup_chunk<S: Shader>(
     };
     let pv = Some(job.projected);
     for t in range {
-        stats.triangles += 1;
         let (cache, indices, target) = (job.cache, job.indices, job.target);
-        match prepare_projected(cache, pv, indices, t, target, &job.opts, &mut binner) {
-            PrepareOutcome::Rejected => stats.rejected += 1,
-            PrepareOutcome::Culled => stats.culled += 1,
-            PrepareOutcome::Drawn { clipped } => {
-                stats.drawn += 1;
-                stats.clipped += u64::from(clipped);
-            }
-        }
+        prepare_projected(cache, pv, indices, t, target, &job.opts, &mut binner)
+            .count(&mut stats, 1);
     }
     binner.chunk.stats = stats;
     fill_bins(binner.chunk);

@@ -22,9 +22,10 @@
 //! it to be handed back costs more than the second thread saves.
 //!
 //! Every triangle is counted by one strip (its owner), so the counters are one
-//! thread's: the strip that holds the first row of its box (clamped to the target),
-//! or the first strip for a triangle that needs clipping or is rejected, which every
-//! strip sets up.
+//! thread's: the strip that holds the first row of its box (clamped to the target).
+//! A triangle with a vertex that needs clipping or did not snap has no box before its
+//! set-up: every strip sets it up, and the first counts it (as it counts one with a
+//! vertex index out of range).
 
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -37,7 +38,7 @@ use crate::raster::depth::DepthRows;
 use crate::render::fragments::PieceWalker;
 use crate::render::isa::DrawVariant;
 use crate::render::options::{DrawOptions, DrawStats};
-use crate::render::prepare::{EmitPiece, PrepareOutcome, Prepared, VertexCache, prepare_projected};
+use crate::render::prepare::{EmitPiece, Prepared, VertexCache, prepare_projected};
 use crate::render::shader::Shader;
 use crate::render::{ColorTarget, Renderer};
 use crate::simd::I32s;
@@ -148,15 +149,7 @@ pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L
             &job.opts,
             &mut cut,
         );
-        stats.triangles += owner;
-        match outcome {
-            PrepareOutcome::Rejected => stats.rejected += owner,
-            PrepareOutcome::Culled => stats.culled += owner,
-            PrepareOutcome::Drawn { clipped } => {
-                stats.drawn += owner;
-                stats.clipped += owner & u64::from(clipped);
-            }
-        }
+        outcome.count(&mut stats, owner);
     }
     stats.fragments = walker.stats.fragments;
     stats.shaded = walker.stats.shaded;

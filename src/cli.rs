@@ -118,6 +118,22 @@ pub enum CliError {
     Usage(String),
 }
 
+impl CliError {
+    /// Whether this is a write to a pipe whose reader has gone (`termrast render … |
+    /// head`): the output is no longer wanted, so the command ends quietly, as a tool
+    /// killed by `SIGPIPE` does.
+    #[must_use]
+    pub fn reader_gone(&self) -> bool {
+        let io = match self {
+            CliError::Io(e)
+            | CliError::Raster(raster_cmd::RasterError::Io(e))
+            | CliError::Line(line_cmd::LineError::Io(e)) => e,
+            _ => return false,
+        };
+        io.kind() == io::ErrorKind::BrokenPipe
+    }
+}
+
 /// Parses `WxH` (e.g. `80x24`) into a target size.
 pub fn parse_size(s: &str) -> Result<Target, String> {
     let (w, h) = s
@@ -236,6 +252,8 @@ pub fn main() -> ExitCode {
         Err(CliError::View(crate::tui::ViewError::Signal(sig))) => {
             ExitCode::from(u8::try_from(128 + sig).unwrap_or(255))
         }
+        // The shell's status for a command ended by `SIGPIPE` (128 + 13).
+        Err(e) if e.reader_gone() => ExitCode::from(141),
         Err(e) => {
             let _ = writeln!(io::stderr(), "termrast: {e}");
             ExitCode::FAILURE

@@ -158,6 +158,28 @@ fn render_writes_text_frames() {
     assert!(ok && out.contains("\u{1b}[38;2;") && out.contains('▀'));
 }
 
+/// A reader that goes away (`termrast render … | head -1`) ends the command quietly,
+/// with the status of a command ended by `SIGPIPE`.
+#[test]
+fn render_ends_quietly_when_its_reader_goes() {
+    use std::io::{BufRead, BufReader};
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_termrast"))
+        .args(["render", "--cols", "40", "--rows", "10", "--frames", "500"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    let mut first = String::new();
+    let mut lines = BufReader::new(child.stdout.take().expect("piped"));
+    lines.read_line(&mut first).expect("a first line");
+    assert!(!first.is_empty());
+    drop(lines);
+    let out = child.wait_with_output().expect("it ends");
+    assert_eq!(out.status.code(), Some(141), "{out:?}");
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "");
+}
+
 fn termrast(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_termrast"))
         .args(args)

@@ -17,6 +17,11 @@ use crate::terminal::{ColorMode, GlyphMode};
 /// Smallest usable terminal.
 pub const MIN_COLS: u16 = 24;
 pub const MIN_ROWS: u16 = 8;
+/// The most cells the viewer uses: a larger terminal shows it in its top-left corner
+/// of this size, so its buffers (which grow with the cells) stay bounded. Wider than a
+/// 4K screen in an 8-pixel font.
+pub const MAX_COLS: u16 = 512;
+pub const MAX_ROWS: u16 = 256;
 /// Width of the inspector panel beside the model.
 pub const PANEL_COLS: u16 = 58;
 /// Cells the cursor moves with Shift (or H J K L).

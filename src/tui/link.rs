@@ -27,6 +27,7 @@ use ratatui::style::{Color, Modifier};
 
 use std::cell::RefCell;
 
+use super::app::{MAX_COLS, MAX_ROWS};
 use crate::terminal::color::{OklabCache, Rgb, indexed_rgb, nearest_256};
 
 /// How far (OKLab distance) a changed cell's colour may stray from the true frame.
@@ -497,7 +498,7 @@ impl<W: Write> Backend for LinkBackend<W> {
             Some(s) => Ok(s),
             None => {
                 let (w, h) = ratatui::crossterm::terminal::size()?;
-                Ok(Size::new(w, h))
+                Ok(Size::new(w.min(MAX_COLS), h.min(MAX_ROWS)))
             }
         }
     }

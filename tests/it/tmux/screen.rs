@@ -1,8 +1,11 @@
 //! What the viewer shows in tmux: the inspector and its panel at several sizes, the
-//! frame-rate cap, the status line's threads, a model's material colours.
+//! frame-rate cap, the status line's threads, a model's material colours, a terminal
+//! larger than the viewer uses.
 
 use std::thread::sleep;
 use std::time::Duration;
+
+use termrast::tui::app::{MAX_COLS, MAX_ROWS};
 
 use super::{Tmux, model_rows, selected_cell, status};
 
@@ -264,4 +267,28 @@ fn truecolor_colours(text: &str) -> Vec<[u8; 3]> {
         }
     }
     out
+}
+
+/// A terminal larger than the viewer uses shows it in its top-left `MAX_COLS` ×
+/// `MAX_ROWS` cells: the status line on the last of those rows, nothing right of them;
+/// and the viewer follows the terminal down to an ordinary size.
+#[test]
+fn a_huge_terminal_shows_the_viewer_in_its_corner() {
+    let (cols, rows) = (MAX_COLS + 88, MAX_ROWS + 44);
+    let Some(t) = Tmux::sized("huge", "sh", cols, rows) else {
+        eprintln!("tmux not installed: skipping the terminal end-to-end test");
+        return;
+    };
+    t.start_viewer_with("TERM=xterm-256color LANG=C.UTF-8", "");
+    let s = t.wait_until(|s| status(s).contains(" ms, "));
+    let lines: Vec<&str> = s.lines().collect();
+    let last = lines.iter().rposition(|l| !l.trim().is_empty());
+    assert_eq!(last, Some(usize::from(MAX_ROWS) - 1), "{}", status(&s));
+    let widest = lines.iter().map(|l| l.trim_end().chars().count()).max();
+    assert!(widest <= Some(usize::from(MAX_COLS)), "{widest:?} columns");
+    t.run(&["resize-window", "-t", "t", "-x", "120", "-y", "40"]);
+    let s = t.wait_until(|s| s.lines().count() <= 40 && status(s).contains(" ms, "));
+    assert!(s.lines().all(|l| l.chars().count() <= 120), "{s}");
+    t.keys(&["q"]);
+    t.assert_restored();
 }

@@ -127,7 +127,8 @@ impl CliError {
         let io = match self {
             CliError::Io(e)
             | CliError::Raster(raster_cmd::RasterError::Io(e))
-            | CliError::Line(line_cmd::LineError::Io(e)) => e,
+            | CliError::Line(line_cmd::LineError::Io(e))
+            | CliError::Serve(crate::serve::ServeError::Io(e)) => e,
             _ => return false,
         };
         io.kind() == io::ErrorKind::BrokenPipe

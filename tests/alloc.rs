@@ -10,7 +10,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering::Relaxed};
 
 use termrast::raster::Target;
-use termrast::render::Spread;
+use termrast::render::{MIN_STRIP_WORK, MIN_THREADED_WORK, Renderer, Spread};
 use termrast::scene::Scene;
 use termrast::scene::render::{SceneFrame, SceneView};
 
@@ -53,32 +53,38 @@ static GLOBAL: Counting = Counting;
 /// Allocations while drawing six frames of `scene` with `frame` once it is steady:
 /// after two frames in a row that allocated nothing (within 40). Buffers whose size
 /// follows the view (a bin's entries as the model turns) may still grow in the first
-/// frames, by doubling; a frame that allocates every time never becomes steady.
+/// frames, by doubling; a frame that allocates every time never becomes steady. With
+/// threads, the whole loop runs on the pool, as the viewer's does (handing each
+/// frame to the pool from outside would allocate in rayon's queue now and then).
 fn allocations(frame: &mut SceneFrame, scene: &Scene, target: Target) -> u64 {
-    let mut k = 0;
-    let mut draw = || {
-        let view = SceneView {
-            yaw: 0.05 * k as f32,
-            ..SceneView::default()
+    let pool = frame.renderer.thread_pool().cloned();
+    let mut measure = || {
+        let mut k = 0;
+        let mut draw = || {
+            let view = SceneView {
+                yaw: 0.05 * k as f32,
+                ..SceneView::default()
+            };
+            k += 1;
+            ALLOCATIONS.store(0, Relaxed);
+            ARMED.store(true, Relaxed);
+            frame.draw(scene, target, &view);
+            ARMED.store(false, Relaxed);
+            ALLOCATIONS.load(Relaxed)
         };
-        k += 1;
-        ALLOCATIONS.store(0, Relaxed);
-        ARMED.store(true, Relaxed);
-        match frame.renderer.thread_pool().cloned() {
-            Some(pool) => pool.install(|| frame.draw(scene, target, &view)),
-            None => frame.draw(scene, target, &view),
+        let mut quiet = 0;
+        for _ in 0..40 {
+            quiet = if draw() == 0 { quiet + 1 } else { 0 };
+            if quiet == 2 {
+                break;
+            }
         }
-        ARMED.store(false, Relaxed);
-        ALLOCATIONS.load(Relaxed)
+        (0..6).map(|_| draw()).sum()
     };
-    let mut quiet = 0;
-    for _ in 0..40 {
-        quiet = if draw() == 0 { quiet + 1 } else { 0 };
-        if quiet == 2 {
-            break;
-        }
+    match pool {
+        Some(pool) => pool.install(measure),
+        None => measure(),
     }
-    (0..6).map(|_| draw()).sum()
 }
 
 /// A scene of the teapot and a quad of two triangles: draws of the same varyings with
@@ -113,30 +119,41 @@ fn steady_frames_allocate_nothing() {
         ),
         ("teapot and quad", teapot_and_quad(&dir)),
     ];
+    // One renderer per thread count for the whole test, lent to each frame: a dropped
+    // pool's threads allocate as they exit, which could land in another setting's
+    // measured frames.
+    let mut renderers = [1, 2, 4].map(|n| {
+        let mut r = Renderer::new(Target::new(1, 1));
+        r.set_threads(n);
+        // Every thread started and taking jobs before anything is counted.
+        if let Some(pool) = r.thread_pool() {
+            pool.broadcast(|_| ());
+        }
+        (n, r)
+    });
     for (name, scene) in &scenes {
         for target in [Target::new(400, 240), Target::new(1280, 720)] {
-            for threads in [1, 2, 4] {
-                let ways: &[Option<Spread>] = if threads == 1 {
+            for (threads, renderer) in &mut renderers {
+                let ways: &[Option<Spread>] = if *threads == 1 {
                     &[None]
                 } else {
                     &[None, Some(Spread::Bins), Some(Spread::Strips)]
                 };
                 for &way in ways {
                     let mut frame = SceneFrame::new(scene);
-                    frame.renderer.set_threads(threads);
-                    match way {
-                        Some(Spread::Bins) => frame.renderer.min_threaded_work = 0,
-                        Some(_) => {
-                            frame.renderer.min_threaded_work = u64::MAX;
-                            frame.renderer.min_strip_work = 0;
-                        }
-                        None => {}
-                    }
+                    std::mem::swap(&mut frame.renderer, renderer);
+                    let r = &mut frame.renderer;
+                    (r.min_threaded_work, r.min_strip_work) = match way {
+                        Some(Spread::Bins) => (0, MIN_STRIP_WORK),
+                        Some(_) => (u64::MAX, 0),
+                        None => (MIN_THREADED_WORK, MIN_STRIP_WORK),
+                    };
                     let n = allocations(&mut frame, scene, target);
                     assert_eq!(n, 0, "{name}, {target:?}, {threads} threads, {way:?}");
                     if let Some(way) = way {
                         assert_eq!(frame.renderer.spread(), way, "{name} {target:?}");
                     }
+                    std::mem::swap(&mut frame.renderer, renderer);
                 }
             }
         }

@@ -475,6 +475,16 @@ fn main_loop<W: Write>(
                 resume(terminal, pacer)?;
                 dirty = true;
             }
+            Some(Wake::Signal(signal_hook::consts::SIGWINCH)) => {
+                // Past the viewer's limit a resize leaves the size it draws at alone,
+                // so ratatui would not repaint; a terminal that cleared or reflowed on
+                // the resize would keep what it made of the screen.
+                let (w, h) = ratatui::crossterm::terminal::size()?;
+                if w > app::MAX_COLS || h > app::MAX_ROWS {
+                    terminal.clear()?;
+                }
+                dirty = true;
+            }
             Some(Wake::Signal(_)) => dirty = true,
             None => {}
         }

@@ -286,6 +286,29 @@ fn a_huge_terminal_shows_the_viewer_in_its_corner() {
     assert_eq!(last, Some(usize::from(MAX_ROWS) - 1), "{}", status(&s));
     let widest = lines.iter().map(|l| l.trim_end().chars().count()).max();
     assert!(widest <= Some(usize::from(MAX_COLS)), "{widest:?} columns");
+    // A terminal that clears its screen on a resize (simulated: the clear written to
+    // the pane's terminal, then a resize that leaves the viewer's size alone) gets
+    // the whole screen again, the status line's unchanging start included.
+    let row = usize::from(MAX_ROWS) - 1;
+    let start = |s: &str| s.lines().nth(row).unwrap_or_default().trim().to_string();
+    let before = start(&s);
+    let head: String = before.chars().take(12).collect();
+    assert!(head.len() >= 6, "{before}");
+    let tty = t.run(&["display", "-p", "-t", "t", "#{pane_tty}"]);
+    let tty = tty.expect("the pane's terminal").trim().to_string();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open(&tty)
+        .and_then(|mut f| std::io::Write::write_all(&mut f, b"\x1b[H\x1b[2J"))
+        .expect("the pane's terminal takes the clear");
+    let (c, r) = ((cols + 10).to_string(), (rows + 10).to_string());
+    t.run(&["resize-window", "-t", "t", "-x", &c, "-y", &r]);
+    let s = t.wait_until(|s| start(s).starts_with(&head));
+    assert!(
+        start(&s).starts_with(&head),
+        "{head:?} again: {:?}",
+        start(&s)
+    );
     t.run(&["resize-window", "-t", "t", "-x", "120", "-y", "40"]);
     let bottom = |s: &str| {
         let lines: Vec<&str> = s.lines().collect();

@@ -114,7 +114,7 @@ pub struct BenchRenderArgs {
     #[arg(long, value_parser = super::parse_size, default_value = "1920x1080")]
     pub size: Target,
     /// Frames to render (each turns the model by 0.05 rad).
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
     /// The draw loop's instruction set: baseline, avx2 or avx512 (default: the best
     /// this CPU has). All give identical images.
@@ -340,7 +340,7 @@ fn bench_frame(args: &BenchRenderArgs, scene: &Scene, threads: Option<usize>) ->
     frame
 }
 
-/// Draws `--frames` frames (at least one), each after `--pause-ms`; returns each
+/// Draws `--frames` frames (clap admits at least one), each after `--pause-ms`; returns each
 /// frame's time in ms, sorted, and the mean covered fragments per frame.
 fn time_frames(args: &BenchRenderArgs, scene: &Scene, frame: &mut SceneFrame) -> (Vec<f64>, u64) {
     let pause = std::time::Duration::from_millis(args.pause_ms);

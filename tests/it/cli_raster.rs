@@ -94,6 +94,15 @@ fn bad_arguments_are_explained() {
     }
     let (ok, _, err) = raster(&["--traversal", "fast"], "");
     assert!(!ok && err.contains("scalar"), "{err}");
+    for command in ["render", "bench render"] {
+        let mut args: Vec<&str> = command.split(' ').collect();
+        args.extend(["--frames", "0"]);
+        let (ok, _, err) = termrast(&args);
+        assert!(
+            !ok && err.contains("'0'") && err.contains("--frames"),
+            "{command}: {err}"
+        );
+    }
 }
 
 #[test]

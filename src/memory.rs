@@ -14,8 +14,15 @@ pub const HUGE_PAGE_MIN_BYTES: usize = 4 << 20;
 
 /// Makes room for `len` elements in `v` (capacity only, contents unchanged), asking
 /// for huge pages behind a new allocation of at least [`HUGE_PAGE_MIN_BYTES`]. Does
-/// nothing when the capacity suffices, so a steady frame loop never allocates here.
+/// nothing when the capacity suffices, so a steady frame loop never allocates here;
+/// but an empty buffer of at least [`HUGE_PAGE_MIN_BYTES`] that holds four times the
+/// room asked for is given back first (a window made much smaller after a large one).
 pub fn reserve_frame<T>(v: &mut Vec<T>, len: usize) {
+    let oversized =
+        v.capacity() * size_of::<T>() >= HUGE_PAGE_MIN_BYTES && v.capacity() / 4 >= len.max(1);
+    if v.is_empty() && oversized {
+        *v = Vec::new();
+    }
     if v.capacity() >= len {
         return;
     }
@@ -26,6 +33,14 @@ pub fn reserve_frame<T>(v: &mut Vec<T>, len: usize) {
     }
     v.reserve_exact(len - v.len());
     advise_huge_pages(v);
+}
+
+/// Refills `v` with `len` copies of `value`, through [`reserve_frame`]: a per-cell or
+/// per-sample buffer sized anew for a frame.
+pub fn refill<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
+    v.clear();
+    reserve_frame(v, len);
+    v.resize(len, value);
 }
 
 /// Asks the kernel to back `v`'s whole allocation with transparent huge pages. Only
@@ -65,6 +80,25 @@ mod tests {
             assert!(v.capacity() >= len);
             assert_eq!(v, (0..start as u32).collect::<Vec<_>>());
         }
+    }
+
+    #[test]
+    fn a_much_smaller_frame_gives_the_room_back() {
+        let big = HUGE_PAGE_MIN_BYTES / 4;
+        let mut v: Vec<u32> = Vec::new();
+        reserve_frame(&mut v, big);
+        reserve_frame(&mut v, big / 2);
+        assert!(v.capacity() >= big, "half the room is kept");
+        reserve_frame(&mut v, big / 8);
+        assert!(v.capacity() < big / 2, "an eighth gives it back");
+        // Contents are never dropped, and small buffers are left alone.
+        let mut w: Vec<u32> = vec![7; 3];
+        w.reserve_exact(big);
+        reserve_frame(&mut w, 4);
+        assert!(w.capacity() >= big && w == [7, 7, 7]);
+        let mut small: Vec<u32> = Vec::with_capacity(1000);
+        reserve_frame(&mut small, 10);
+        assert_eq!(small.capacity(), 1000);
     }
 
     #[test]

@@ -28,6 +28,7 @@ use ratatui::style::{Color, Modifier};
 use std::cell::RefCell;
 
 use super::app::{MAX_COLS, MAX_ROWS};
+use crate::memory::refill;
 use crate::terminal::color::{OklabCache, Rgb, indexed_rgb, nearest_256};
 
 /// How far (OKLab distance) a changed cell's colour may stray from the true frame.
@@ -133,12 +134,9 @@ impl<W: Write> LinkBackend<W> {
         self.cols = s.width;
         self.rows = s.height;
         let n = usize::from(s.width) * usize::from(s.height);
-        self.wanted.clear();
-        self.wanted.resize(n, Cell::EMPTY);
-        self.shown.clear();
-        self.shown.resize(n, Cell::EMPTY);
-        self.changed.clear();
-        self.changed.resize(n, false);
+        refill(&mut self.wanted, n, Cell::EMPTY);
+        refill(&mut self.shown, n, Cell::EMPTY);
+        refill(&mut self.changed, n, false);
         self.cursor = None;
         self.pen = None;
         self.hidden = None;

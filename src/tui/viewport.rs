@@ -206,8 +206,11 @@ impl Viewport {
         let cols = usize::from(self.cols);
         let start = Instant::now();
         let mut cells = std::mem::take(&mut self.cells);
-        cells.clear();
-        cells.resize(cols * usize::from(self.rows), CellGlyph::default());
+        crate::memory::refill(
+            &mut cells,
+            cols * usize::from(self.rows),
+            CellGlyph::default(),
+        );
         if cols > 0 {
             let this = &*self;
             cells

@@ -391,8 +391,7 @@ fn resolve(fine: &Rgba8, ft: Target, side: u32, out: &mut Rgba8, target: Target,
     let bg = background
         .to_array()
         .map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u32);
-    out.0.clear();
-    out.0.resize(target.len(), [0; 4]);
+    crate::memory::refill(&mut out.0, target.len(), [0; 4]);
     counters::add(Stage::Resolves, target.len() as u64);
     for y in 0..target.height {
         for x in 0..target.width {

@@ -479,8 +479,10 @@ fn main_loop<W: Write>(
                 // Past the viewer's limit a resize leaves the size it draws at alone,
                 // so ratatui would not repaint; a terminal that cleared or reflowed on
                 // the resize would keep what it made of the screen.
-                let (w, h) = ratatui::crossterm::terminal::size()?;
-                if w > app::MAX_COLS || h > app::MAX_ROWS {
+                // A size the terminal cannot tell is left to the next draw to report.
+                let past = ratatui::crossterm::terminal::size()
+                    .is_ok_and(|(w, h)| w > app::MAX_COLS || h > app::MAX_ROWS);
+                if past {
                     terminal.clear()?;
                 }
                 dirty = true;

@@ -303,7 +303,9 @@ pub fn prepare_projected<V: Varying>(
     let Some(idx) = indices.get(base..base + 3) else {
         return PrepareOutcome::Rejected;
     };
-    let fetch = |i: u32| cache.verts.get(i as usize).copied();
+    // By reference: a triangle inside every plane reads only the varyings, once it
+    // knows their order (`setup_piece`).
+    let fetch = |i: u32| cache.verts.get(i as usize);
     let (Some(a), Some(b), Some(c)) = (fetch(idx[0]), fetch(idx[1]), fetch(idx[2])) else {
         return PrepareOutcome::Rejected;
     };
@@ -326,16 +328,16 @@ pub fn prepare_projected<V: Varying>(
     match outcome {
         ClipOutcome::Rejected => return PrepareOutcome::Rejected,
         ClipOutcome::Inside => {
-            let var = each3!(|i| tri[i].var);
+            let var = each3!(|i| &tri[i].var);
             seen.add(setup_piece((t, 0, clipped), pv, var, target, opts, emit));
         }
         ClipOutcome::Clipped => {
-            let Some(poly) = clip_straddling(tri, guard) else {
+            let Some(poly) = clip_straddling([*a, *b, *c], guard) else {
                 return PrepareOutcome::Rejected;
             };
             for (i, tri) in poly.triangles().enumerate() {
                 let pv = each3!(|i| Projected::of(tri[i].pos, target, guard));
-                let var = each3!(|i| tri[i].var);
+                let var = each3!(|i| &tri[i].var);
                 seen.add(setup_piece((t, i, clipped), pv, var, target, opts, emit));
             }
         }
@@ -381,7 +383,7 @@ enum Piece {
 fn setup_piece<V: Varying>(
     (t, piece, clipped): (u32, usize, bool),
     pv: [Projected; 3],
-    var: [V; 3],
+    var: [&V; 3],
     target: Target,
     opts: &DrawOptions,
     emit: &mut impl EmitPiece<V>,
@@ -398,7 +400,7 @@ fn setup_piece<V: Varying>(
         return Piece::Culled;
     }
     let order = |i: usize| if setup.flipped && i > 0 { 3 - i } else { i };
-    let var = each3!(|i| var[order(i)]);
+    let var = each3!(|i| *var[order(i)]);
     // The raw value at the box's origin less 256 times the reduced one.
     let g = setup.reduced_at_origin();
     let edge_rem = each3!(|e| (setup.origin[e] - setup.bias[e] - (g[e] << SUBPIXEL_BITS)) as f32);

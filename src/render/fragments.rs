@@ -17,12 +17,18 @@ use crate::simd::{F32s, I32s, each3};
 ///
 /// The variant `V` says which options are compile-time constants (see
 /// [`DrawVariant`]); the lanes `L` are those of the copy's instruction set. Depth
-/// lives in `D`: the whole buffer, or the band of rows a thread draws, whose first
-/// pixel ([`DepthStore::base`]) is index 0 of both its depth and its colour `C`.
-struct Fragments<'a, S: Shader, C, L, V, D> {
+/// holds the whole buffer's values, or those of the band of rows a thread draws,
+/// whose first pixel (`base`) is index 0 of both its depth and its colour `C`.
+struct Fragments<'a, S: Shader, C, L, V> {
     tri: &'a Prepared<S::Varying>,
     shader: &'a S,
-    depth: &'a mut D,
+    /// The depth values, their stale tiles under the triangle filled
+    /// ([`DepthStore::filled_mut`]), and the frame's index of the first
+    /// ([`DepthStore::base`]): taken once per triangle, since the compiler cannot
+    /// tell that the colour and depth writes of a group leave the buffer's fields
+    /// alone, and would otherwise load them again for every group.
+    depth: &'a mut [f32],
+    base: usize,
     color: &'a mut C,
     opts: DrawOptions,
     width: usize,
@@ -36,23 +42,23 @@ struct Fragments<'a, S: Shader, C, L, V, D> {
     lanes: PhantomData<(L, V)>,
 }
 
-impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore> CoverageSink
-    for Fragments<'_, S, C, L, V, D>
+impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> CoverageSink
+    for Fragments<'_, S, C, L, V>
 {
     #[inline(always)]
     fn pixel(&mut self, x: u32, y: u32) {
         let e = self.tri.eval(x, y);
-        let i = y as usize * self.width + x as usize - self.depth.base();
+        let i = y as usize * self.width + x as usize - self.base;
         self.stats.fragments += 1;
         let (depth_state, interpolation) = V::state(&self.opts);
         if depth_state.uses_buffer() {
             counters::add(Stage::DepthTests, 1);
-            let old = self.depth.filled_mut()[i];
+            let old = self.depth[i];
             if !depth_state.func.passes(e.depth, old) {
                 return;
             }
             if depth_state.write {
-                self.depth.filled_mut()[i] = e.depth;
+                self.depth[i] = e.depth;
             }
         }
         let v = self.tri.varyings(&e, interpolation);
@@ -100,9 +106,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore> Coverage
     }
 }
 
-impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore>
-    Fragments<'_, S, C, L, V, D>
-{
+impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> Fragments<'_, S, C, L, V> {
     /// A group that reaches past the target (only in targets under 8 pixels wide, see
     /// [`CoverageSink::mask8`]), pixel by pixel (bit `k` is pixel `k % 8` of row
     /// `k / 8`).
@@ -145,7 +149,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore>
     #[inline(always)]
     fn shade_lanes<F: F32s>(&mut self, y: u32, x0: u32, mask: u32, g: [F; 3]) {
         let t = self.tri;
-        let start = y as usize * self.width + x0 as usize - self.depth.base();
+        let start = y as usize * self.width + x0 as usize - self.base;
         // Rows below the first only when the mask has lanes there: the last row of the
         // target has none below it.
         let stride = if F::ROWS > 1 && mask >> 8 != 0 {
@@ -159,7 +163,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore>
         let (depth_state, interpolation) = V::state(&self.opts);
         let pass = if depth_state.uses_buffer() {
             counters::add(Stage::DepthTests, u64::from(mask.count_ones()));
-            let buf = self.depth.filled_mut();
+            let buf = &mut *self.depth;
             let old = F::load_rows(buf, start, stride);
             let test = match depth_state.func {
                 DepthFunc::Less => depth.lt(old).bitmask(),
@@ -268,10 +272,12 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore>
             let b = setup.bbox;
             self.depth.fill_stale(b.x0, b.y0, b.x1, b.y1);
         }
-        let mut frag = Fragments::<S, C, L, V, D> {
+        let base = self.depth.base();
+        let mut frag = Fragments::<S, C, L, V> {
             tri,
             shader: self.shader,
-            depth: &mut *self.depth,
+            depth: self.depth.filled_mut(),
+            base,
             color: &mut *self.color,
             opts: self.opts,
             width: self.width,

@@ -32,6 +32,10 @@ impl ColorTarget for UvTarget {
 
     type Rows<'a> = UvRows<'a>;
 
+    fn all_rows(&mut self) -> UvRows<'_> {
+        UvRows(&mut self.0[..])
+    }
+
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = UvRows<'_>> {
         self.0.par_chunks_mut(pixels).map(UvRows)
     }
@@ -60,6 +64,10 @@ impl ColorTarget for UvRows<'_> {
         = UvRows<'a>
     where
         Self: 'a;
+
+    fn all_rows(&mut self) -> UvRows<'_> {
+        UvRows(&mut self.0[..])
+    }
 
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = UvRows<'_>> {
         self.0.par_chunks_mut(pixels).map(UvRows)

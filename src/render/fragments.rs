@@ -19,7 +19,7 @@ use crate::simd::{F32s, I32s, each3};
 /// [`DrawVariant`]); the lanes `L` are those of the copy's instruction set. Depth
 /// holds the whole buffer's values, or those of the band of rows a thread draws,
 /// whose first pixel (`base`) is index 0 of both its depth and its colour `C`.
-struct Fragments<'a, S: Shader, C, L, V> {
+struct Fragments<'a, S: Shader, C: ColorTarget + 'a, L, V> {
     tri: &'a Prepared<S::Varying>,
     shader: &'a S,
     /// The depth values, their stale tiles under the triangle filled
@@ -29,7 +29,8 @@ struct Fragments<'a, S: Shader, C, L, V> {
     /// alone, and would otherwise load them again for every group.
     depth: &'a mut [f32],
     base: usize,
-    color: &'a mut C,
+    /// The colour target, held by value for the same reason.
+    color: C::Rows<'a>,
     opts: DrawOptions,
     width: usize,
     /// The draw's counters, added to per group. Not per-triangle counts merged at the
@@ -278,7 +279,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant, D: DepthStore>
             shader: self.shader,
             depth: self.depth.filled_mut(),
             base,
-            color: &mut *self.color,
+            color: self.color.all_rows(),
             opts: self.opts,
             width: self.width,
             stats: &mut self.stats,

@@ -50,6 +50,11 @@ pub trait ColorTarget: Send {
     where
         Self: 'a;
 
+    /// The whole target as one band: what a triangle's fragment loop holds by value,
+    /// so that the compiler keeps its storage's address in a register rather than
+    /// loading it again behind a reference for every group.
+    fn all_rows(&mut self) -> Self::Rows<'_>;
+
     /// The target in bands of `pixels` pixels each (the last may be shorter), first
     /// to last: disjoint borrows, so threads can write them at once.
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = Self::Rows<'_>>;
@@ -182,6 +187,11 @@ impl ColorTarget for Rgba8 {
 
     type Rows<'a> = Rgba8Rows<'a>;
 
+    #[inline(always)]
+    fn all_rows(&mut self) -> Rgba8Rows<'_> {
+        Rgba8Rows(&mut self.0[..])
+    }
+
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = Rgba8Rows<'_>> {
         self.0.par_chunks_mut(pixels).map(Rgba8Rows)
     }
@@ -221,6 +231,11 @@ impl ColorTarget for Rgba8Rows<'_> {
         = Rgba8Rows<'a>
     where
         Self: 'a;
+
+    #[inline(always)]
+    fn all_rows(&mut self) -> Rgba8Rows<'_> {
+        Rgba8Rows(&mut self.0[..])
+    }
 
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = Rgba8Rows<'_>> {
         self.0.par_chunks_mut(pixels).map(Rgba8Rows)

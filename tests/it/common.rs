@@ -112,6 +112,13 @@ impl ColorTarget for Exact {
 
     type Rows<'a> = ExactRows<'a>;
 
+    fn all_rows(&mut self) -> ExactRows<'_> {
+        ExactRows {
+            colors: &mut self.colors[..],
+            writes: &mut self.writes[..],
+        }
+    }
+
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = ExactRows<'_>> {
         let writes = self.writes.par_chunks_mut(pixels);
         (self.colors.par_chunks_mut(pixels).zip(writes))
@@ -151,6 +158,13 @@ impl ColorTarget for ExactRows<'_> {
         = ExactRows<'a>
     where
         Self: 'a;
+
+    fn all_rows(&mut self) -> ExactRows<'_> {
+        ExactRows {
+            colors: &mut self.colors[..],
+            writes: &mut self.writes[..],
+        }
+    }
 
     fn bands(&mut self, pixels: usize) -> impl IndexedParallelIterator<Item = ExactRows<'_>> {
         let writes = self.writes.par_chunks_mut(pixels);

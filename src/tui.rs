@@ -481,7 +481,7 @@ fn main_loop<W: Write>(
                 // the resize would keep what it made of the screen.
                 // A size the terminal cannot tell is left to the next draw to report.
                 let past = ratatui::crossterm::terminal::size()
-                    .is_ok_and(|(w, h)| w > app::MAX_COLS || h > app::MAX_ROWS);
+                    .is_ok_and(|(w, h)| app::used_size(w, h) != (w, h));
                 if past {
                     terminal.clear()?;
                 }

@@ -22,6 +22,12 @@ pub const MIN_ROWS: u16 = 8;
 /// 4K screen in an 8-pixel font.
 pub const MAX_COLS: u16 = 512;
 pub const MAX_ROWS: u16 = 256;
+
+/// The part of a terminal of `cols` × `rows` cells the viewer uses (see [`MAX_COLS`]).
+#[must_use]
+pub fn used_size(cols: u16, rows: u16) -> (u16, u16) {
+    (cols.min(MAX_COLS), rows.min(MAX_ROWS))
+}
 /// Width of the inspector panel beside the model.
 pub const PANEL_COLS: u16 = 58;
 /// Cells the cursor moves with Shift (or H J K L).

@@ -27,7 +27,7 @@ use ratatui::style::{Color, Modifier};
 
 use std::cell::RefCell;
 
-use super::app::{MAX_COLS, MAX_ROWS};
+use super::app::used_size;
 use crate::memory::refill;
 use crate::terminal::color::{OklabCache, Rgb, indexed_rgb, nearest_256};
 
@@ -496,7 +496,8 @@ impl<W: Write> Backend for LinkBackend<W> {
             Some(s) => Ok(s),
             None => {
                 let (w, h) = ratatui::crossterm::terminal::size()?;
-                Ok(Size::new(w.min(MAX_COLS), h.min(MAX_ROWS)))
+                let (w, h) = used_size(w, h);
+                Ok(Size::new(w, h))
             }
         }
     }

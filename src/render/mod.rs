@@ -104,6 +104,11 @@ pub struct Renderer {
     /// ([`Spread::Strips`]), if the caller runs on the pool ([`Renderer::plan_frame`]);
     /// below it, the draw is too short for the threads to meet in time. Tests set 0.
     pub min_strip_work: u64,
+    /// The fewest pixels per triangle and thread of a draw of at least
+    /// [`Renderer::min_threaded_work`] drawn in strips ([`Spread::Strips`]); a denser
+    /// one is binned ([`Spread::Bins`]). [`MIN_STRIP_PIXELS`] by default; tests set
+    /// `u64::MAX` to bin every such draw.
+    pub min_strip_pixels: u64,
     /// The fewest vertices whose vertex stage ([`Renderer::transform`]) runs on the
     /// frame's threads; [`MIN_PARALLEL_VERTICES`] by default. Tests set 0.
     pub min_parallel_vertices: usize,
@@ -111,8 +116,9 @@ pub struct Renderer {
     spread: Spread,
     /// Whether this frame may use the pool at all ([`Renderer::plan_frame`]).
     frame_threads: bool,
-    /// Whether this frame is worth binning ([`Spread::Bins`]).
-    frame_bins: bool,
+    /// Whether this frame is worth the threads wherever the caller runs (at least
+    /// [`Renderer::min_threaded_work`]).
+    frame_large: bool,
     /// For a loop that draws paced frames, the measured choice between the pool and
     /// the calling thread ([`Renderer::set_measured`]); `None` uses the pool for
     /// every frame worth it.
@@ -146,15 +152,27 @@ pub const MIN_THREADED_WORK: u64 = 1 << 19;
 /// samples (0.21 M) gains from strips; the teapot there (0.13 M, 0.14 ms) does not.
 pub const MIN_STRIP_WORK: u64 = 1 << 17;
 
+/// The default [`Renderer::min_strip_pixels`]. In strips, every strip scans every
+/// triangle and the threads' shares are fixed for the draw (corrected from draw to
+/// draw by when the strips ended); binned, each triangle is set up once and the bands
+/// go to whichever thread is free, but every record goes through memory between two
+/// parallel steps. On two threads at 1920×1080 strips are faster down to some 64
+/// pixels a triangle (the bunny, spheres of 16k and 32k triangles) and even at 32
+/// (the 65k sphere), by the VM's phase (see `docs/performance.md`).
+pub const MIN_STRIP_PIXELS: u64 = 24;
+
 /// How a draw is shared among the renderer's threads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Spread {
     /// On the calling thread alone.
     One,
     /// A strip of rows per thread, each setting up the triangles that reach it
-    /// (`tiles/strips`): for draws of less than [`Renderer::min_threaded_work`].
+    /// (`tiles/strips`): for every draw but a dense one of at least
+    /// [`Renderer::min_threaded_work`].
     Strips,
-    /// Set up once and binned by bands of rows, then walked band by band (`tiles`).
+    /// Set up once and binned by bands of rows, then walked band by band (`tiles`):
+    /// for draws of at least [`Renderer::min_threaded_work`] denser than
+    /// [`Renderer::min_strip_pixels`].
     Bins,
 }
 
@@ -173,10 +191,11 @@ impl Renderer {
             pending_clear: None,
             min_threaded_work: MIN_THREADED_WORK,
             min_strip_work: MIN_STRIP_WORK,
+            min_strip_pixels: MIN_STRIP_PIXELS,
             min_parallel_vertices: MIN_PARALLEL_VERTICES,
             spread: Spread::One,
             frame_threads: true,
-            frame_bins: true,
+            frame_large: true,
             choice: None,
         }
     }
@@ -229,15 +248,15 @@ impl Renderer {
             .pool
             .as_ref()
             .is_some_and(|p| p.current_thread_index().is_some());
-        self.frame_bins = work >= self.min_threaded_work;
-        self.frame_threads = self.frame_bins || (on_pool && work >= self.min_strip_work);
+        self.frame_large = work >= self.min_threaded_work;
+        self.frame_threads = self.frame_large || (on_pool && work >= self.min_strip_work);
         if self.frame_threads
             && self.pool.is_some()
             && let Some(choice) = &mut self.choice
             && !choice.pooled(work, kind)
         {
             self.frame_threads = false;
-            self.frame_bins = false;
+            self.frame_large = false;
         }
     }
 
@@ -455,11 +474,15 @@ impl Renderer {
         if opts.depth.uses_buffer() && !self.has_depth() {
             self.depth.reset(self.target.width, self.target.height);
         }
-        let work = self.target.len() as u64 + TRIANGLE_WORK * (indices.len() / 3) as u64;
+        let (pixels, triangles) = (self.target.len() as u64, (indices.len() / 3) as u64);
+        let work = pixels + TRIANGLE_WORK * triangles;
+        let large = self.frame_large && work >= self.min_threaded_work;
+        let strip_pixels = self.min_strip_pixels.saturating_mul(self.threads() as u64);
+        let dense = pixels < strip_pixels.saturating_mul(triangles);
         self.spread = match () {
             _ if !S::THREADED || !self.tiled() => Spread::One,
-            _ if self.frame_bins && work >= self.min_threaded_work => Spread::Bins,
-            _ if work >= self.min_strip_work => Spread::Strips,
+            _ if large && dense => Spread::Bins,
+            _ if large || work >= self.min_strip_work => Spread::Strips,
             _ => Spread::One,
         };
         if self.spread == Spread::One {

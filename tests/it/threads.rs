@@ -13,8 +13,9 @@ use termrast::raster::{Target, Traversal};
 use termrast::render::probe::DepthOutcome;
 use termrast::render::target::to_u8;
 use termrast::render::{
-    BAND_ROWS, DENSE_BAND_ROWS, DrawOptions, DrawStats, Isa, Renderer, Spread, VertexCache,
-    band_rows, project_vertices, strip_ends, vertex_spans,
+    BAND_ROWS, DENSE_BAND_ROWS, DrawOptions, DrawStats, Isa, MIN_STRIP_PIXELS, MIN_THREADED_WORK,
+    Renderer, Spread, TRIANGLE_WORK, VertexCache, band_rows, project_vertices, strip_ends,
+    vertex_spans,
 };
 use termrast::scene::Scene;
 use termrast::scene::render::{SceneFrame, SceneView};
@@ -32,7 +33,10 @@ const WAYS: [Spread; 2] = [Spread::Bins, Spread::Strips];
 /// (the draw then projects the vertices itself).
 fn share(r: &mut Renderer, way: Spread, parallel_vertices: bool) {
     match way {
-        Spread::Bins => r.min_threaded_work = 0,
+        Spread::Bins => {
+            r.min_threaded_work = 0;
+            r.min_strip_pixels = u64::MAX;
+        }
         _ => {
             r.min_threaded_work = u64::MAX;
             r.min_strip_work = 0;
@@ -225,6 +229,47 @@ fn strips_frame_after_frame_equal_one_thread() {
         let many = (frame.color.0.clone(), depth, frame.stats);
         let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
         assert!(one == many, "frame {n}");
+    }
+}
+
+/// With the default thresholds, a large draw goes in strips unless it has fewer than
+/// `MIN_STRIP_PIXELS` pixels per triangle and thread: then it is binned. Whether the
+/// caller runs on the pool or not, and each frame is one thread's.
+#[test]
+fn large_draws_go_in_strips_unless_dense() {
+    let options = (Interpolation::Perspective, Traversal::Wide, Isa::detect());
+    for (spec, target, way) in [
+        ("sphere:16384", Target::new(1280, 720), Spread::Strips),
+        ("sphere:32768", Target::new(96, 64), Spread::Bins),
+    ] {
+        let scene = model(spec);
+        let triangles = scene.objects[0].mesh.triangle_count() as u64;
+        let work = target.len() as u64 + TRIANGLE_WORK * triangles;
+        assert!(
+            work >= MIN_THREADED_WORK,
+            "{spec} {target:?} is a large draw"
+        );
+        let dense = (target.len() as u64) < MIN_STRIP_PIXELS * 2 * triangles;
+        assert_eq!(dense, way == Spread::Bins, "{spec} {target:?}");
+        let mut frame = SceneFrame::new(&scene);
+        (frame.interpolation, frame.traversal, frame.renderer.isa) = options;
+        frame.renderer.set_threads(2);
+        let pool = frame.renderer.thread_pool().cloned().expect("two threads");
+        let view = turned(0.4);
+        for on_pool in [true, false] {
+            if on_pool {
+                pool.install(|| frame.draw(&scene, target, &view));
+            } else {
+                frame.draw(&scene, target, &view);
+            }
+            let at = format!("{spec} {target:?}, on the pool: {on_pool}");
+            assert_eq!(frame.renderer.spread(), way, "{at}");
+            let depth = frame.renderer.depth.to_vec();
+            let depth: Vec<u32> = depth.iter().map(|d| d.to_bits()).collect();
+            let many = (frame.color.0.clone(), depth, frame.stats);
+            let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
+            assert!(one == many, "{at}");
+        }
     }
 }
 

@@ -1,25 +1,30 @@
-//! Small frames on several threads: one strip of rows per thread, each setting up
-//! every triangle that reaches its rows and walking it there at once.
+//! Draws on several threads in one step: one strip of rows per thread, each setting
+//! up every triangle that reaches its rows and walking it there at once.
 //!
-//! A frame of a few hundred thousand pixels and a few thousand triangles (a model at
-//! terminal size) is done in well under a millisecond; binning ([`super::draw`])
-//! then costs more than the second thread saves, as its set-up records go through
-//! memory between two parallel steps. Here there is one step: each thread scans the
+//! Binning ([`super::draw`]) sends every set-up record through memory between two
+//! parallel steps. A frame of a few hundred thousand pixels and a few thousand
+//! triangles (a model at terminal size) is done in well under a millisecond, and
+//! binning then costs more than the second thread saves; so does it for a larger
+//! draw whose triangles are large (from
+//! [`MIN_STRIP_PIXELS`](crate::render::MIN_STRIP_PIXELS) pixels per triangle and
+//! thread, `Renderer::draw`). Here there is one step: each thread scans the
 //! triangles in draw order, skips those whose box misses its strip, and sets up and
 //! walks the others with their boxes cut to its rows
 //! ([`Setup::rows`](crate::raster::Setup::rows)), as one thread would. Only triangles
 //! crossing a strip's border are set up twice. The scan reads one word per vertex,
 //! the rows a box takes from it ([`vertex_spans`]), made once before the strips
 //! start: the box's rows run from the least first row of its vertices to the
-//! greatest last row.
+//! greatest last row. It grows with the triangles, for every strip: a dense draw is
+//! binned.
 //!
 //! The strips are placed by the vertices' first rows (counted per 8 rows before the
 //! draw): at first each holds as many, then each draw's shares are corrected by the
 //! time each strip took to end ([`Shares`]), since a vertex costs more where its
-//! triangles are larger or the other thread starts later. The strips are worth it only
-//! to a caller that runs on the pool's threads itself (`Renderer::plan_frame`):
-//! handing a frame of a few hundred microseconds to a sleeping thread and waiting for
-//! it to be handed back costs more than the second thread saves.
+//! triangles are larger or the other thread starts later. A small frame is worth
+//! strips only to a caller that runs on the pool's threads itself
+//! (`Renderer::plan_frame`): handing a frame of a few hundred microseconds to a
+//! sleeping thread and waiting for it to be handed back costs more than the second
+//! thread saves.
 //!
 //! Every triangle is counted by one strip (its owner), so the counters are one
 //! thread's: the strip that holds the first row of its box (clamped to the target).
@@ -156,7 +161,7 @@ pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L
     stats
 }
 
-/// Draws on the renderer's pool with copy `T`, a strip per thread: the small-frame
+/// Draws on the renderer's pool with copy `T`, a strip per thread: the one-step
 /// form of `Renderer::draw_triangles`, with the same frame and counters.
 ///
 /// # Safety

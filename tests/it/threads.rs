@@ -69,9 +69,14 @@ fn frame_bits(
     if threads > 1 {
         assert_eq!(frame.renderer.spread(), way, "{target:?}");
     }
+    bits(&frame)
+}
+
+/// The colour, depth bits and counters of `frame`'s last frame.
+fn bits(frame: &SceneFrame) -> Bits {
     let depth = frame.renderer.depth.to_vec();
     let depth = depth.iter().map(|d| d.to_bits()).collect();
-    (frame.color.0, depth, frame.stats)
+    (frame.color.0.clone(), depth, frame.stats)
 }
 
 fn turned(yaw: f32) -> SceneView {
@@ -224,9 +229,7 @@ fn strips_frame_after_frame_equal_one_thread() {
         let view = turned(0.3 * n as f32);
         pool.install(|| frame.draw(&scene, target, &view));
         assert_eq!(frame.renderer.spread(), Spread::Strips);
-        let depth = frame.renderer.depth.to_vec();
-        let depth: Vec<u32> = depth.iter().map(|d| d.to_bits()).collect();
-        let many = (frame.color.0.clone(), depth, frame.stats);
+        let many = bits(&frame);
         let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
         assert!(one == many, "frame {n}");
     }
@@ -264,9 +267,7 @@ fn large_draws_go_in_strips_unless_dense() {
             }
             let at = format!("{spec} {target:?}, on the pool: {on_pool}");
             assert_eq!(frame.renderer.spread(), way, "{at}");
-            let depth = frame.renderer.depth.to_vec();
-            let depth: Vec<u32> = depth.iter().map(|d| d.to_bits()).collect();
-            let many = (frame.color.0.clone(), depth, frame.stats);
+            let many = bits(&frame);
             let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
             assert!(one == many, "{at}");
         }
@@ -296,9 +297,7 @@ fn measured_frames_take_both_ways_and_equal_one_thread() {
             pooled[usize::from(on_pool)] += 1;
             let expected = if on_pool { way } else { Spread::One };
             assert_eq!(frame.renderer.spread(), expected, "frame {n}");
-            let depth = frame.renderer.depth.to_vec();
-            let depth: Vec<u32> = depth.iter().map(|d| d.to_bits()).collect();
-            let bits = (frame.color.0.clone(), depth, frame.stats);
+            let bits = bits(&frame);
             let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
             assert!(one == bits, "{way:?} frame {n}");
         }

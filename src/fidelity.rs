@@ -2,7 +2,7 @@
 //! stands for (`termrast bench fidelity`).
 //!
 //! Per view, a reference is rendered with the viewport's own camera at twice the
-//! painted screen's pixel size and box-filtered in linear light ([`reference`]). Each
+//! painted screen's pixel size and box-filtered in linear light ([`mod@reference`]). Each
 //! glyph mode × colour depth is rendered by the viewport, encoded to ANSI bytes, fed
 //! through a terminal emulator and painted back to pixels at 8×16 per cell
 //! ([`crate::terminal::paint`]); chafa's output, when chafa is installed, goes the

@@ -6,7 +6,7 @@
 //! - [`server`]: connections, limits, the log, shutdown; `conn.rs`: authentication
 //!   and refusals (russh's handler);
 //! - [`session`]: a watcher's viewer on its own thread, bounded both ways;
-//! - [`bench`]: the load generator (`termrast bench serve`).
+//! - [`mod@bench`]: the load generator (`termrast bench serve`).
 //!
 //! It sits on top with `cli`: nothing below imports it.
 

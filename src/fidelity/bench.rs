@@ -73,7 +73,7 @@ pub const PALETTES: [Palette; 2] = [Palette::XTERM, Palette::CHAFA];
 /// one is nearest) whatever the terminal has, so its frames are shown on the palette
 /// it assumes and on xterm's. termrast fits to the palette the terminal reports (at 256
 /// colours using 0–15 only then), so each of its indexed frames is fitted to the
-/// palette it is painted on ([`measure_view`] renders one per palette).
+/// palette it is painted on (`measure_view` renders one per palette).
 #[must_use]
 pub fn palettes(colors: ColorMode) -> &'static [Palette] {
     match colors {

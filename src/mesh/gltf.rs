@@ -1,6 +1,6 @@
 //! glTF 2.0 models, `.gltf` (JSON, with external or `data:` buffers) and `.glb`, read
 //! with the `gltf` crate's document model; the bytes are found and checked here (see
-//! [`data`]), never by `gltf::import`, so every file goes through the same guards as
+//! `data`), never by `gltf::import`, so every file goes through the same guards as
 //! the model itself.
 //!
 //! What is read: every primitive of triangle mode (strips and fans are converted) of

@@ -219,7 +219,7 @@ impl DepthBuffer {
 
     /// Fills the stale tiles overlapping pixels `x0..=x1` × `y0..=y1` with
     /// [`DEPTH_CLEAR`]. Costs a word test per tile row when none is stale: the
-    /// renderer calls this once per triangle (see [`DepthRows::fill_stale`]).
+    /// renderer calls this once per triangle (see `DepthRows::fill_stale`).
     #[inline(always)]
     pub fn fill_stale(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
         self.all_rows().fill_stale(x0, y0, x1, y1);

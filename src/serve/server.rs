@@ -1,7 +1,7 @@
 //! The SSH side: accepting connections within the limits, authentication, what a
 //! session may ask for, one log line per connection, and shutting down.
 //!
-//! Each connection gets a [`super::conn::Conn`], russh's handler.
+//! Each connection gets a `Conn` (`conn`), russh's handler.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasher, RandomState};

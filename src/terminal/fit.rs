@@ -4,7 +4,7 @@
 //! see [`FitSpace`](super::glyphs::FitSpace)).
 //!
 //! A glyph drawn with foreground `f` and background `b` covers a fraction `αᵢ` of
-//! sample `i`'s box (its weights, from [`shapes::ink`](super::shapes::ink)), which the
+//! sample `i`'s box (its weights, from [`shapes::ink`]), which the
 //! eye sees as `b + αᵢ(f − b)`. For a fixed glyph the best `b` and `d = f − b` solve a
 //! least-squares problem per channel whose normal equations involve only `X = Σxᵢ`
 //! (the cell's sum, the same for every glyph) and `Y = Σαᵢxᵢ`; the error left is

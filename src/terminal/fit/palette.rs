@@ -125,7 +125,7 @@ pub const CANDIDATES: usize = 32;
 
 /// The shape of `rep` and the two entries of `pal` closest to the samples `x` (in the
 /// palette's fit space, row-major 4 × 8) in summed squared error, over every shape and
-/// pair; a single entry (a space) wins unless a glyph removes [`GLYPH_GAIN`] of its
+/// pair; a single entry (a space) wins unless a glyph removes `GLYPH_GAIN` of its
 /// error.
 #[must_use]
 pub fn fit_palette<'r>(rep: &'r Repertoire, x: &[[f32; 3]; N], pal: &FitPalette) -> PaletteFit<'r> {

@@ -156,9 +156,10 @@ pub const MIN_STRIP_WORK: u64 = 1 << 17;
 /// triangle and the threads' shares are fixed for the draw (corrected from draw to
 /// draw by when the strips ended); binned, each triangle is set up once and the bands
 /// go to whichever thread is free, but every record goes through memory between two
-/// parallel steps. On two threads at 1920×1080 strips are faster down to some 64
-/// pixels a triangle (the bunny, spheres of 16k and 32k triangles) and even at 32
-/// (the 65k sphere), by the VM's phase (see `docs/performance.md`).
+/// parallel steps. On two threads at 1920×1080 strips are faster down to some 32
+/// pixels per triangle and thread (the bunny, spheres of 16k and 32k triangles); at 16
+/// (the 65k sphere) they come out faster or slower by the VM's phase (see
+/// `docs/performance.md`).
 pub const MIN_STRIP_PIXELS: u64 = 24;
 
 /// How a draw is shared among the renderer's threads.
@@ -167,8 +168,8 @@ pub enum Spread {
     /// On the calling thread alone.
     One,
     /// A strip of rows per thread, each setting up the triangles that reach it
-    /// (`tiles/strips`): for every draw but a dense one of at least
-    /// [`Renderer::min_threaded_work`].
+    /// (`tiles/strips`): for a draw of at least [`Renderer::min_strip_work`], unless
+    /// it is a dense one of at least [`Renderer::min_threaded_work`].
     Strips,
     /// Set up once and binned by bands of rows, then walked band by band (`tiles`):
     /// for draws of at least [`Renderer::min_threaded_work`] denser than

@@ -447,7 +447,13 @@ impl DepthRows<'_> {
             let x0 = (w * 64 + m.trailing_zeros() as usize) * TILE_W as usize;
             let x1 = (x0 + TILE_W as usize).min(width);
             for y in y0..y1 {
-                self.data[y * width + x0..y * width + x1].fill(DEPTH_CLEAR);
+                let row = &mut self.data[y * width + x0..y * width + x1];
+                // A whole tile row is one cache line of known length: stored in line,
+                // where `fill` calls `memset` (a call per row of every tile).
+                match <&mut [f32; TILE_W as usize]>::try_from(&mut *row) {
+                    Ok(line) => *line = [DEPTH_CLEAR; TILE_W as usize],
+                    Err(_) => row.fill(DEPTH_CLEAR),
+                }
             }
             m &= m - 1;
         }

@@ -448,8 +448,9 @@ impl DepthRows<'_> {
             let x1 = (x0 + TILE_W as usize).min(width);
             for y in y0..y1 {
                 let row = &mut self.data[y * width + x0..y * width + x1];
-                // A whole tile row is one cache line of known length: stored in line,
-                // where `fill` calls `memset` (a call per row of every tile).
+                // A whole tile row is one cache line of known length, stored as one
+                // array: a slice `fill` of unknown length runs a loop of thrice the
+                // instructions.
                 match <&mut [f32; TILE_W as usize]>::try_from(&mut *row) {
                     Ok(line) => *line = [DEPTH_CLEAR; TILE_W as usize],
                     Err(_) => row.fill(DEPTH_CLEAR),

@@ -4,12 +4,12 @@
 //! Binning ([`super::draw`]) sends every set-up record through memory between two
 //! parallel steps. A frame of a few hundred thousand pixels and a few thousand
 //! triangles (a model at terminal size) is done in well under a millisecond, and
-//! binning then costs more than the second thread saves; so does it for a larger
-//! draw whose triangles are large (from
-//! [`MIN_STRIP_PIXELS`](crate::render::MIN_STRIP_PIXELS) pixels per triangle and
-//! thread, `Renderer::draw`). Here there is one step: each thread scans the
-//! triangles in draw order, skips those whose box misses its strip, and sets up and
-//! walks the others with their boxes cut to its rows
+//! binning then costs more than the second thread saves. A larger draw of large
+//! triangles (from [`MIN_STRIP_PIXELS`](crate::render::MIN_STRIP_PIXELS) pixels per
+//! triangle and thread, `Renderer::draw`) is faster in strips too: each triangle is
+//! walked as soon as it is set up, with few borders to cross. Here there is one
+//! step: each thread scans the triangles in draw order, skips those whose box misses
+//! its strip, and sets up and walks the others with their boxes cut to its rows
 //! ([`Setup::rows`](crate::raster::Setup::rows)), as one thread would. Only triangles
 //! crossing a strip's border are set up twice. The scan reads one word per vertex,
 //! the rows a box takes from it ([`vertex_spans`]), made once before the strips

@@ -28,6 +28,7 @@ pub const MAX_ROWS: u16 = 256;
 pub fn used_size(cols: u16, rows: u16) -> (u16, u16) {
     (cols.min(MAX_COLS), rows.min(MAX_ROWS))
 }
+
 /// Width of the inspector panel beside the model.
 pub const PANEL_COLS: u16 = 58;
 /// Cells the cursor moves with Shift (or H J K L).

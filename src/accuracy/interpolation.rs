@@ -10,7 +10,7 @@ use super::workloads::{Scene3, UvShader};
 use super::{Config, Errors, Family, Row};
 use crate::raster::Target;
 use crate::raster::interp::Interpolation;
-use crate::render::target::split_slice;
+use crate::render::target::{SplitOff, split_off_slice, split_slice};
 use crate::render::{ColorTarget, DrawOptions, Renderer, VertexCache, transform};
 
 /// Texture coordinates per pixel (NaN where nothing was drawn).
@@ -47,6 +47,12 @@ impl ColorTarget for UvTarget {
 
 /// A band of rows of a [`UvTarget`].
 struct UvRows<'a>(&'a mut [[f32; 2]]);
+
+impl SplitOff for UvRows<'_> {
+    fn split_off(&mut self, pixels: usize) -> Self {
+        UvRows(split_off_slice(&mut self.0, pixels))
+    }
+}
 
 impl ColorTarget for UvRows<'_> {
     #[inline(always)]

@@ -340,6 +340,45 @@ impl DepthBuffer {
     }
 }
 
+impl<'a> DepthRows<'a> {
+    /// The first of these rows.
+    pub(crate) fn first_row(&self) -> u32 {
+        self.y0
+    }
+
+    /// The first row after these (exclusive).
+    pub(crate) fn end(&self) -> u32 {
+        self.y0 + self.rows
+    }
+
+    /// Cuts these rows at row `at` (of the frame, a multiple of [`TILE_H`] within
+    /// them): keeps the rows above it and returns the rest, so a thread can hand part
+    /// of its rows to another while drawing.
+    pub(crate) fn split_off(&mut self, at: u32) -> DepthRows<'a> {
+        assert!(
+            at >= self.y0 && at <= self.end() && (at - self.y0).is_multiple_of(TILE_H),
+            "rows {}..{} cut at {at}",
+            self.y0,
+            self.end()
+        );
+        let kept = at - self.y0;
+        let px = (kept as usize * self.width as usize).min(self.data.len());
+        let bits = ((kept / TILE_H) as usize * self.words).min(self.stale.len());
+        let (data, data_rest) = std::mem::take(&mut self.data).split_at_mut(px);
+        let (stale, stale_rest) = std::mem::take(&mut self.stale).split_at_mut(bits);
+        let rest = DepthRows {
+            data: data_rest,
+            stale: stale_rest,
+            words: self.words,
+            width: self.width,
+            y0: at,
+            rows: self.rows - kept,
+        };
+        (self.data, self.stale, self.rows) = (data, stale, kept);
+        rest
+    }
+}
+
 /// Where the fragment stage tests and writes depth: the whole [`DepthBuffer`], or one
 /// band of its rows ([`DepthRows`]) that a thread owns while others draw the rest.
 pub(crate) trait DepthStore {

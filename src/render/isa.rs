@@ -252,7 +252,8 @@ pub(super) mod baseline {
 
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
-    use crate::render::tiles::strips::{self, StripPlan};
+    use crate::render::target::SplitOff;
+    use crate::render::tiles::strips::{self, Handover, Part, StripPlan};
     use crate::render::tiles::{self, Chunk, Job, TileCopy};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
@@ -277,15 +278,14 @@ pub(super) mod baseline {
         ) -> DrawStats {
             tiles::walk_band::<V, S, C, wide::i32x8>(job, chunks, band, color, depth, clear)
         }
-        unsafe fn strip<S: Shader, C: ColorTarget>(
+        unsafe fn strip<'d, S: Shader, C: ColorTarget + SplitOff>(
             job: &Job<'_, S>,
             plan: &StripPlan<'_>,
-            strip: usize,
-            color: &mut C,
-            depth: &mut DepthRows<'_>,
+            part: &mut Part<'d, C>,
+            handover: &Handover<'d, C>,
             clear: Option<Vec3>,
         ) -> DrawStats {
-            strips::draw_strip::<V, S, C, wide::i32x8>(job, plan, strip, color, depth, clear)
+            strips::draw_strip::<V, S, C, wide::i32x8>(job, plan, part, handover, clear)
         }
     }
 
@@ -313,7 +313,8 @@ pub(super) mod avx2 {
 
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
-    use crate::render::tiles::strips::{self, StripPlan};
+    use crate::render::target::SplitOff;
+    use crate::render::tiles::strips::{self, Handover, Part, StripPlan};
     use crate::render::tiles::{self, Chunk, Job, TileCopy};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
@@ -340,16 +341,15 @@ pub(super) mod avx2 {
             // SAFETY: the caller's guarantee.
             unsafe { walk::<V, S, C>(job, chunks, band, color, depth, clear) }
         }
-        unsafe fn strip<S: Shader, C: ColorTarget>(
+        unsafe fn strip<'d, S: Shader, C: ColorTarget + SplitOff>(
             job: &Job<'_, S>,
             plan: &StripPlan<'_>,
-            strip: usize,
-            color: &mut C,
-            depth: &mut DepthRows<'_>,
+            part: &mut Part<'d, C>,
+            handover: &Handover<'d, C>,
             clear: Option<Vec3>,
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
-            unsafe { self::strip::<V, S, C>(job, plan, strip, color, depth, clear) }
+            unsafe { self::strip::<V, S, C>(job, plan, part, handover, clear) }
         }
     }
 
@@ -385,17 +385,14 @@ pub(super) mod avx2 {
     /// # Safety
     /// As for [`draw`].
     #[target_feature(enable = "avx2,fma,popcnt,bmi1")]
-    unsafe fn strip<V: DrawVariant, S: Shader, C: ColorTarget>(
+    unsafe fn strip<'d, V: DrawVariant, S: Shader, C: ColorTarget + SplitOff>(
         job: &Job<'_, S>,
         plan: &StripPlan<'_>,
-        strip: usize,
-        color: &mut C,
-        depth: &mut DepthRows<'_>,
+        part: &mut Part<'d, C>,
+        handover: &Handover<'d, C>,
         clear: Option<Vec3>,
     ) -> DrawStats {
-        strips::draw_strip::<V, S, C, crate::simd::avx2::I32x8>(
-            job, plan, strip, color, depth, clear,
-        )
+        strips::draw_strip::<V, S, C, crate::simd::avx2::I32x8>(job, plan, part, handover, clear)
     }
 
     /// The draw loop of variant `V` compiled with AVX2 and FMA enabled and on
@@ -430,7 +427,8 @@ pub(super) mod avx512 {
 
     use crate::raster::depth::DepthRows;
     use crate::render::options::DrawStats;
-    use crate::render::tiles::strips::{self, StripPlan};
+    use crate::render::target::SplitOff;
+    use crate::render::tiles::strips::{self, Handover, Part, StripPlan};
     use crate::render::tiles::{self, Chunk, Job, TileCopy};
     use crate::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache};
 
@@ -457,16 +455,15 @@ pub(super) mod avx512 {
             // SAFETY: the caller's guarantee.
             unsafe { walk::<S, C>(job, chunks, band, color, depth, clear) }
         }
-        unsafe fn strip<S: Shader, C: ColorTarget>(
+        unsafe fn strip<'d, S: Shader, C: ColorTarget + SplitOff>(
             job: &Job<'_, S>,
             plan: &StripPlan<'_>,
-            strip: usize,
-            color: &mut C,
-            depth: &mut DepthRows<'_>,
+            part: &mut Part<'d, C>,
+            handover: &Handover<'d, C>,
             clear: Option<Vec3>,
         ) -> DrawStats {
             // SAFETY: the caller's guarantee.
-            unsafe { self::strip::<S, C>(job, plan, strip, color, depth, clear) }
+            unsafe { self::strip::<S, C>(job, plan, part, handover, clear) }
         }
     }
 
@@ -502,16 +499,15 @@ pub(super) mod avx512 {
     /// # Safety
     /// As for [`draw`].
     #[target_feature(enable = "avx2,fma,popcnt,bmi1,avx512f,avx512vl,avx512bw,avx512dq")]
-    unsafe fn strip<S: Shader, C: ColorTarget>(
+    unsafe fn strip<'d, S: Shader, C: ColorTarget + SplitOff>(
         job: &Job<'_, S>,
         plan: &StripPlan<'_>,
-        strip: usize,
-        color: &mut C,
-        depth: &mut DepthRows<'_>,
+        part: &mut Part<'d, C>,
+        handover: &Handover<'d, C>,
         clear: Option<Vec3>,
     ) -> DrawStats {
         strips::draw_strip::<Fast, S, C, crate::simd::avx512::I32x16>(
-            job, plan, strip, color, depth, clear,
+            job, plan, part, handover, clear,
         )
     }
 

@@ -74,7 +74,7 @@ pub use prepare::{
     prepare_projected, project_vertices, transform, transform_projected,
 };
 pub use shader::{ShadeLanes, Shader};
-pub use target::{ColorTarget, Rgba8, Rgba8Rows};
+pub use target::{ColorTarget, Rgba8, Rgba8Rows, SplitOff};
 pub use tiles::strips::{ALL_ROWS, MAX_STRIPS, strip_ends, vertex_spans};
 pub use tiles::{BAND_ROWS, DENSE_BAND_ROWS, band_rows};
 
@@ -454,6 +454,13 @@ impl Renderer {
     #[must_use]
     pub fn spread(&self) -> Spread {
         self.spread
+    }
+
+    /// How many times, over every draw so far, a thread done with its strip took
+    /// rows from one still drawing ([`Spread::Strips`]).
+    #[must_use]
+    pub fn handovers(&self) -> u64 {
+        self.scratch.handovers
     }
 
     /// Whether this frame has a depth buffer.

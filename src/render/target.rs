@@ -46,7 +46,7 @@ pub trait ColorTarget: Send {
 
     /// A band of whole rows of the target, indexed from the band's first pixel: what
     /// one thread of a threaded draw writes while the others write the other bands.
-    type Rows<'a>: ColorTarget + Send
+    type Rows<'a>: ColorTarget + SplitOff + Send
     where
         Self: 'a;
 
@@ -63,6 +63,21 @@ pub trait ColorTarget: Send {
     /// `ends` (ascending, clamped to the target), first to last, each handed to `f`:
     /// disjoint borrows, for draws that share the rows unevenly among threads.
     fn split_rows<'s>(&'s mut self, ends: &[usize], f: impl FnMut(Self::Rows<'s>));
+}
+
+/// A band of rows that can be cut in two while it is drawn: a thread that runs out of
+/// rows takes some of another's (see `render::tiles::strips`).
+pub trait SplitOff: Sized {
+    /// Keeps the first `pixels` pixels and returns the rest.
+    fn split_off(&mut self, pixels: usize) -> Self;
+}
+
+/// [`SplitOff::split_off`] of a slice.
+pub fn split_off_slice<'a, T>(slice: &mut &'a mut [T], pixels: usize) -> &'a mut [T] {
+    let at = pixels.min(slice.len());
+    let (kept, rest) = std::mem::take(slice).split_at_mut(at);
+    *slice = kept;
+    rest
 }
 
 /// Cuts `rest` at `ends` (ascending, clamped to its length), handing each piece to `f`
@@ -204,6 +219,12 @@ impl ColorTarget for Rgba8 {
 /// A band of rows of an [`Rgba8`] target (see [`ColorTarget::bands`]).
 #[derive(Debug)]
 pub struct Rgba8Rows<'a>(pub &'a mut [[u8; 4]]);
+
+impl SplitOff for Rgba8Rows<'_> {
+    fn split_off(&mut self, pixels: usize) -> Self {
+        Rgba8Rows(split_off_slice(&mut self.0, pixels))
+    }
+}
 
 impl ColorTarget for Rgba8Rows<'_> {
     #[inline(always)]

@@ -47,13 +47,13 @@ use super::isa::DrawVariant;
 use super::options::{DrawOptions, DrawStats};
 use super::prepare::{Projected, VertexCache};
 use super::shader::Shader;
-use super::target::ColorTarget;
+use super::target::{ColorTarget, SplitOff};
 use super::{Renderer, Spread};
 use crate::raster::Target;
 use crate::raster::depth::DepthRows;
 use crate::simd::{I32s, prefetch};
 use queue::plan_bands;
-use strips::StripPlan;
+use strips::{Handover, Part, StripPlan};
 use vertices::projections;
 pub(super) use vertices::transform_claimed;
 
@@ -114,6 +114,8 @@ pub(super) struct Scratch {
     pub(super) shares: Vec<strips::Shares>,
     /// The draws in strips so far in this frame ([`Scratch::begin_frame`]).
     pub(super) strip_draws: usize,
+    /// Rows handed from one strip's thread to another's, over every draw.
+    pub(super) handovers: u64,
 }
 
 impl std::fmt::Debug for Scratch {
@@ -208,18 +210,17 @@ pub(super) trait TileCopy {
         clear: Option<Vec3>,
     ) -> DrawStats;
 
-    /// Draws strip `strip` of `plan`'s of every triangle into its rows of colour and
-    /// depth, first filling the colour rows with `clear` if given (see
-    /// [`strips::draw_strip`]); returns its counters.
+    /// Draws `part`'s rows of colour and depth of every triangle from its first on,
+    /// first filling the colour rows with `clear` if given, handing rows over when
+    /// asked (see [`strips::draw_strip`]); returns its counters.
     ///
     /// # Safety
     /// As for [`TileCopy::setup`].
-    unsafe fn strip<S: Shader, C: ColorTarget>(
+    unsafe fn strip<'d, S: Shader, C: ColorTarget + SplitOff>(
         job: &Job<'_, S>,
         plan: &StripPlan<'_>,
-        strip: usize,
-        color: &mut C,
-        depth: &mut DepthRows<'_>,
+        part: &mut Part<'d, C>,
+        handover: &Handover<'d, C>,
         clear: Option<Vec3>,
     ) -> DrawStats;
 }

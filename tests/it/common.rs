@@ -4,7 +4,9 @@ use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use termrast::raster::{CountGrid, CoverageSink, Setup, Target, Traversal, oracle};
 use termrast::render::target::split_slice;
-use termrast::render::{ColorTarget, DrawOptions, Renderer, Shader, VertexCache, transform};
+use termrast::render::{
+    ColorTarget, DrawOptions, Renderer, Shader, SplitOff, VertexCache, transform,
+};
 
 /// A sink that checks every reported pixel lies in the target and the bbox.
 pub struct CheckedGrid {
@@ -134,6 +136,19 @@ impl ColorTarget for Exact {
 pub struct ExactRows<'a> {
     colors: &'a mut [Option<Vec3>],
     writes: &'a mut [u32],
+}
+
+impl SplitOff for ExactRows<'_> {
+    fn split_off(&mut self, pixels: usize) -> Self {
+        let at = pixels.min(self.colors.len());
+        let (colors, colors_rest) = std::mem::take(&mut self.colors).split_at_mut(at);
+        let (writes, writes_rest) = std::mem::take(&mut self.writes).split_at_mut(at);
+        (self.colors, self.writes) = (colors, writes);
+        ExactRows {
+            colors: colors_rest,
+            writes: writes_rest,
+        }
+    }
 }
 
 impl ColorTarget for ExactRows<'_> {

@@ -235,6 +235,44 @@ fn strips_frame_after_frame_equal_one_thread() {
     }
 }
 
+/// A thread done with its strip takes rows from one still drawing, mid-draw: with
+/// shares that leave the other strips nearly empty, rows are handed over, on two and
+/// on four threads, for each instruction set and interpolation mode, and each frame
+/// (colour, depth bits, counters) is one thread's.
+#[test]
+fn rows_handed_over_mid_draw_keep_one_threads_frame() {
+    let scene = model("sphere:4096");
+    let target = Target::new(320, 200);
+    for isa in Isa::supported() {
+        for interpolation in [Interpolation::Perspective, Interpolation::Affine] {
+            let options = (interpolation, Traversal::Wide, isa);
+            for threads in [2, 4] {
+                let mut frame = SceneFrame::new(&scene);
+                (frame.interpolation, frame.traversal, frame.renderer.isa) = options;
+                frame.renderer.set_threads(threads);
+                share(&mut frame.renderer, Spread::Strips, true);
+                let pool = frame.renderer.thread_pool().cloned().expect("threads");
+                // The calling thread draws the first strip, the others start later.
+                let mut shares = vec![0.2; threads];
+                shares[0] = 1.0;
+                for n in 0..8 {
+                    frame.renderer.set_strip_shares(0, &shares);
+                    let view = turned(0.3 * n as f32);
+                    pool.install(|| frame.draw(&scene, target, &view));
+                    assert_eq!(frame.renderer.spread(), Spread::Strips);
+                    let many = bits(&frame);
+                    let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
+                    assert!(one == many, "{options:?} {threads} threads, frame {n}");
+                }
+                assert!(
+                    frame.renderer.handovers() > 0,
+                    "{options:?} {threads} threads: no rows handed over"
+                );
+            }
+        }
+    }
+}
+
 /// With the default thresholds, a large draw goes in strips unless it has fewer than
 /// `MIN_STRIP_PIXELS` pixels per triangle and thread: then it is binned. Whether the
 /// caller runs on the pool or not, and each frame is one thread's.

@@ -20,17 +20,20 @@
 //! The strips are placed by the vertices' first rows (counted per 8 rows before the
 //! draw): at first each holds as many, then each draw's shares are corrected by the
 //! time each strip took to end ([`Shares`]), since a vertex costs more where its
-//! triangles are larger or the other thread starts later. A small frame is worth
+//! triangles are larger or the other thread starts later. Within a draw, a thread
+//! done with its rows takes the lower half of another's, which goes on from the next
+//! triangle with the rest (`steal`): so the threads end together even when a core
+//! slows down mid-draw. A small frame is worth
 //! strips only to a caller that runs on the pool's threads itself
 //! (`Renderer::plan_frame`): handing a frame of a few hundred microseconds to a
 //! sleeping thread and waiting for it to be handed back costs more than the second
 //! thread saves.
 //!
 //! Every triangle is counted by one strip (its owner), so the counters are one
-//! thread's: the strip that holds the first row of its box (clamped to the target).
-//! A triangle with a vertex that needs clipping or did not snap has no box before its
-//! set-up: every strip sets it up, and the first counts it (as it counts one with a
-//! vertex index out of range).
+//! thread's: the rows that hold the first row of its box (clamped to the target)
+//! when the triangle is drawn. A triangle with a vertex that needs clipping or did
+//! not snap has no box before its set-up: every strip sets it up, and the rows from
+//! the top count it (as they count one with a vertex index out of range).
 
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -45,20 +48,21 @@ use crate::render::isa::DrawVariant;
 use crate::render::options::{DrawOptions, DrawStats};
 use crate::render::prepare::{EmitPiece, Prepared, VertexCache, prepare_projected};
 use crate::render::shader::Shader;
+use crate::render::target::SplitOff;
 use crate::render::{ColorTarget, Renderer};
 use crate::simd::I32s;
 
 mod place;
+mod steal;
 
 pub use place::{ALL_ROWS, SHARED_DRAWS, Shares, strip_ends, vertex_spans};
+pub(in crate::render) use steal::{Handover, Part};
 
 /// The most strips a draw is cut into: a larger pool leaves its other threads idle.
 pub const MAX_STRIPS: usize = 16;
 
 /// What every strip of a draw reads besides the [`Job`].
 pub(in crate::render) struct StripPlan<'a> {
-    /// The row each strip ends at (exclusive); the last is the target's height.
-    pub ends: &'a [u32],
     /// Per vertex, the rows a box takes from it ([`vertex_spans`]).
     pub spans: &'a [u32],
 }
@@ -96,69 +100,93 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> StripWalk<S::Varying>
     }
 }
 
-/// Draws strip `strip` of `plan`'s (its rows of `color` and `depth`) of every
-/// triangle of the draw, first filling the colour rows with `clear` if given, with
-/// variant `V` on lanes `L`; returns the strip's counters. The body of every copy's
-/// [`TileCopy::strip`].
+/// Draws `part`'s rows (its colour and depth) of every triangle of the draw from its
+/// first on, first filling the colour rows with `clear` if given, with variant `V` on
+/// lanes `L`; hands the lower half of its rows to a thread that asks for them
+/// (`handover`) and goes on with the rest. Returns the rows' counters. The body of
+/// every copy's [`TileCopy::strip`].
 #[inline(always)]
-pub(in crate::render) fn draw_strip<V: DrawVariant, S: Shader, C: ColorTarget, L: I32s>(
+pub(in crate::render) fn draw_strip<
+    'd,
+    V: DrawVariant,
+    S: Shader,
+    C: ColorTarget + SplitOff,
+    L: I32s,
+>(
     job: &Job<'_, S>,
     plan: &StripPlan<'_>,
-    strip: usize,
-    color: &mut C,
-    depth: &mut DepthRows<'_>,
+    part: &mut Part<'d, C>,
+    handover: &Handover<'d, C>,
     clear: Option<Vec3>,
 ) -> DrawStats {
     if let Some(background) = clear {
-        let len = color.len();
-        color.reset(len, background);
+        let len = part.color.len();
+        part.color.reset(len, background);
     }
-    let y0 = if strip == 0 { 0 } else { plan.ends[strip - 1] };
-    let y1 = plan.ends[strip] - 1;
-    let mut walker =
-        PieceWalker::<S, C, L, V, _>::new(job.shader, depth, color, &job.opts, job.target);
     let mut stats = DrawStats::default();
     let (indices, projected, spans) = (job.indices, job.projected, plan.spans);
     let n = (indices.len() / 3) as u32;
-    for t in 0..n {
-        let base = t as usize * 3;
-        let span = |k: usize| spans.get(indices[base + k] as usize).copied();
-        let (Some(a), Some(b), Some(c)) = (span(0), span(1), span(2)) else {
-            // A vertex out of range: rejected, counted by the first strip.
-            if strip == 0 {
-                stats.triangles += 1;
-                stats.rejected += 1;
-            }
-            continue;
-        };
-        // The box's first row (clamped to the target) is in its owner's strip.
-        let top = (a & 0xffff).min(b & 0xffff).min(c & 0xffff);
-        let bottom = (a >> 16).max(b >> 16).max(c >> 16);
-        // 1 for the owner, added to its counters without a branch: a branch on it after
-        // the set-up made the compiler copy the whole set-up and walk for each side.
-        let owner = u64::from((y0..=y1).contains(&top));
-        if owner == 0 && (bottom < y0 || top > y1) {
-            continue;
-        }
-        let mut cut = Cut {
-            walker: &mut walker,
-            rows: [y0, y1],
-        };
-        let (cache, target) = (job.cache, job.target);
-        let outcome = prepare_projected(
-            cache,
-            Some(projected),
-            indices,
-            t,
-            target,
+    // One loop, left to hand rows over and entered again: the walk is inlined, and a
+    // second call of it would be a second copy of the set-up and walk.
+    loop {
+        let [y0, y1] = part.rows();
+        let mut walker = PieceWalker::<S, C, L, V, _>::new(
+            job.shader,
+            &mut part.depth,
+            &mut part.color,
             &job.opts,
-            &mut cut,
+            job.target,
         );
-        outcome.count(&mut stats, owner);
+        let mut asked = None;
+        for t in part.first..n {
+            if handover.asked(part.worker) {
+                asked = Some(t);
+                break;
+            }
+            let base = t as usize * 3;
+            let span = |k: usize| spans.get(indices[base + k] as usize).copied();
+            let (Some(a), Some(b), Some(c)) = (span(0), span(1), span(2)) else {
+                // A vertex out of range: rejected, counted by the rows from the top.
+                if y0 == 0 {
+                    stats.triangles += 1;
+                    stats.rejected += 1;
+                }
+                continue;
+            };
+            // The box's first row (clamped to the target) is in its owner's rows.
+            let top = (a & 0xffff).min(b & 0xffff).min(c & 0xffff);
+            let bottom = (a >> 16).max(b >> 16).max(c >> 16);
+            // 1 for the owner, added to its counters without a branch: a branch on it
+            // after the set-up made the compiler copy the whole set-up and walk for
+            // each side.
+            let owner = u64::from((y0..=y1).contains(&top));
+            if owner == 0 && (bottom < y0 || top > y1) {
+                continue;
+            }
+            let mut cut = Cut {
+                walker: &mut walker,
+                rows: [y0, y1],
+            };
+            let (cache, target) = (job.cache, job.target);
+            let outcome = prepare_projected(
+                cache,
+                Some(projected),
+                indices,
+                t,
+                target,
+                &job.opts,
+                &mut cut,
+            );
+            outcome.count(&mut stats, owner);
+        }
+        stats.fragments += walker.stats.fragments;
+        stats.shaded += walker.stats.shaded;
+        let Some(next) = asked else {
+            return stats;
+        };
+        handover.answer(part, next);
+        part.first = next;
     }
-    stats.fragments = walker.stats.fragments;
-    stats.shaded = walker.stats.shaded;
-    stats
 }
 
 /// Draws on the renderer's pool with copy `T`, a strip per thread: the one-step
@@ -192,7 +220,6 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
     let (ends, count, draw) = place_strips(scratch, target.height, wanted);
     let ends = &ends[..count];
     let plan = StripPlan {
-        ends,
         spans: &scratch.spans,
     };
     let clear = r.pending_clear.take();
@@ -209,7 +236,7 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
     for (p, &e) in pixel_ends.iter_mut().zip(ends) {
         *p = e as usize * target.width as usize;
     }
-    let mut parts: [Option<(C::Rows<'_>, DepthRows<'_>)>; MAX_STRIPS] = Default::default();
+    let mut parts: [Option<Part<'_, C::Rows<'_>>>; MAX_STRIPS] = Default::default();
     let mut colors = [const { None }; MAX_STRIPS];
     let mut k = 0;
     color.split_rows(&pixel_ends[..count], |c| {
@@ -217,13 +244,20 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
         k += 1;
     });
     let mut k = 0;
-    r.depth.split_rows(ends, |d| {
-        parts[k] = colors[k].take().map(|c| (c, d));
+    r.depth.split_rows(ends, |depth| {
+        parts[k] = colors[k].take().map(|color| Part {
+            color,
+            depth,
+            first: 0,
+            worker: k,
+        });
         k += 1;
     });
+    let handover = Handover::new(count, target.width as usize);
     // Strips run by rayon's join: one that no thread has taken when the calling
     // thread is done with its own (the others asleep) is drawn by the calling thread.
-    // One that another thread has started is waited for by spinning, briefly: put to
+    // A thread done with its strip takes rows from one still drawing; one still
+    // drawing when no rows can be had is waited for by spinning, briefly: put to
     // sleep, the calling thread would wake later than the strip ends.
     let (started, done) = (AtomicUsize::new(0), AtomicUsize::new(0));
     // When each strip ended, in nanoseconds from `begin` (at least 1).
@@ -235,17 +269,25 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
             .enumerate()
             .with_max_len(1)
             .map(|(i, part)| {
-                let Some((c, d)) = part.as_mut() else {
+                let Some(part) = part.as_mut() else {
                     return DrawStats::default();
                 };
                 if i > 0 {
                     started.fetch_add(1, Ordering::AcqRel);
                 }
                 let start = Instant::now();
-                // SAFETY: the caller's guarantee.
-                let stats = unsafe { T::strip(&job, &plan, i, c, d, clear) };
+                let mut stats = {
+                    let _drawing = handover.drawing(i);
+                    // SAFETY: the caller's guarantee.
+                    unsafe { T::strip(&job, &plan, part, &handover, clear) }
+                };
                 let end = u64::try_from(begin.elapsed().as_nanos()).unwrap_or(u64::MAX);
                 ended[i].store(end.max(1), Ordering::Relaxed);
+                while let Some(mut given) = handover.take(i) {
+                    let _drawing = handover.drawing(i);
+                    // SAFETY: the caller's guarantee.
+                    stats += unsafe { T::strip(&job, &plan, &mut given, &handover, None) };
+                }
                 if i > 0 {
                     done.fetch_add(1, Ordering::Release);
                 } else {
@@ -265,6 +307,7 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
             })
     });
     r.stats += stats;
+    r.scratch.handovers += handover.given();
     let mut times = [0; MAX_STRIPS];
     for (t, e) in times.iter_mut().zip(&ended) {
         *t = e.load(Ordering::Relaxed);

@@ -10,7 +10,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering::Relaxed};
 
 use termrast::raster::Target;
-use termrast::render::{MIN_STRIP_PIXELS, MIN_STRIP_WORK, MIN_THREADED_WORK, Renderer, Spread};
+use termrast::render::{MIN_STRIP_WORK, MIN_THREADED_WORK, Renderer, STRIP_DENSITY, Spread};
 use termrast::scene::Scene;
 use termrast::scene::render::{SceneFrame, SceneView};
 
@@ -143,10 +143,10 @@ fn steady_frames_allocate_nothing() {
                     let mut frame = SceneFrame::new(scene);
                     std::mem::swap(&mut frame.renderer, renderer);
                     let r = &mut frame.renderer;
-                    (r.min_threaded_work, r.min_strip_work, r.min_strip_pixels) = match way {
-                        Some(Spread::Bins) => (0, MIN_STRIP_WORK, u64::MAX),
-                        Some(_) => (u64::MAX, 0, MIN_STRIP_PIXELS),
-                        None => (MIN_THREADED_WORK, MIN_STRIP_WORK, MIN_STRIP_PIXELS),
+                    (r.min_threaded_work, r.min_strip_work, r.strip_density) = match way {
+                        Some(Spread::Bins) => (0, MIN_STRIP_WORK, 0),
+                        Some(_) => (u64::MAX, 0, STRIP_DENSITY),
+                        None => (MIN_THREADED_WORK, MIN_STRIP_WORK, STRIP_DENSITY),
                     };
                     let n = allocations(&mut frame, scene, target);
                     assert_eq!(n, 0, "{name}, {target:?}, {threads} threads, {way:?}");

@@ -104,11 +104,11 @@ pub struct Renderer {
     /// ([`Spread::Strips`]), if the caller runs on the pool ([`Renderer::plan_frame`]);
     /// below it, the draw is too short for the threads to meet in time. Tests set 0.
     pub min_strip_work: u64,
-    /// The fewest pixels per triangle and thread of a draw of at least
+    /// The most triangles per pixel, counted once per thread, of a draw of at least
     /// [`Renderer::min_threaded_work`] drawn in strips ([`Spread::Strips`]); a denser
-    /// one is binned ([`Spread::Bins`]). [`MIN_STRIP_PIXELS`] by default; tests set
-    /// `u64::MAX` to bin every such draw.
-    pub min_strip_pixels: u64,
+    /// one is binned ([`Spread::Bins`]). [`STRIP_DENSITY`] by default; tests set 0 to
+    /// bin every such draw.
+    pub strip_density: u64,
     /// The fewest vertices whose vertex stage ([`Renderer::transform`]) runs on the
     /// frame's threads; [`MIN_PARALLEL_VERTICES`] by default. Tests set 0.
     pub min_parallel_vertices: usize,
@@ -152,15 +152,14 @@ pub const MIN_THREADED_WORK: u64 = 1 << 19;
 /// samples (0.21 M) gains from strips; the teapot there (0.13 M, 0.14 ms) does not.
 pub const MIN_STRIP_WORK: u64 = 1 << 17;
 
-/// The default [`Renderer::min_strip_pixels`]. In strips, every strip scans every
-/// triangle and the threads' shares are fixed for the draw (corrected from draw to
-/// draw by when the strips ended); binned, each triangle is set up once and the bands
-/// go to whichever thread is free, but every record goes through memory between two
-/// parallel steps. On two threads at 1920×1080 strips are faster down to some 32
-/// pixels per triangle and thread (the bunny, spheres of 16k and 32k triangles); at 16
-/// (the 65k sphere) they come out faster or slower by the VM's phase (see
-/// `docs/performance.md`).
-pub const MIN_STRIP_PIXELS: u64 = 24;
+/// The default [`Renderer::strip_density`]. In strips every strip scans every
+/// triangle, and a thread that takes another's rows scans the rest again; binned, each
+/// triangle is set up once, but every record goes through memory between two parallel
+/// steps and the walk waits for the set-up. On two threads strips are faster up to
+/// about one triangle per pixel and thread (the 65k sphere at 1920×1080 and at
+/// 400×240, the million-triangle sphere at 1920×1080), even at 2.7 and much slower
+/// from 5 up (the million-triangle sphere at 400×240; see `docs/performance.md`).
+pub const STRIP_DENSITY: u64 = 2;
 
 /// How a draw is shared among the renderer's threads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -173,7 +172,7 @@ pub enum Spread {
     Strips,
     /// Set up once and binned by bands of rows, then walked band by band (`tiles`):
     /// for draws of at least [`Renderer::min_threaded_work`] denser than
-    /// [`Renderer::min_strip_pixels`].
+    /// [`Renderer::strip_density`].
     Bins,
 }
 
@@ -192,7 +191,7 @@ impl Renderer {
             pending_clear: None,
             min_threaded_work: MIN_THREADED_WORK,
             min_strip_work: MIN_STRIP_WORK,
-            min_strip_pixels: MIN_STRIP_PIXELS,
+            strip_density: STRIP_DENSITY,
             min_parallel_vertices: MIN_PARALLEL_VERTICES,
             spread: Spread::One,
             frame_threads: true,
@@ -485,8 +484,8 @@ impl Renderer {
         let (pixels, triangles) = (self.target.len() as u64, (indices.len() / 3) as u64);
         let work = pixels + TRIANGLE_WORK * triangles;
         let large = self.frame_large && work >= self.min_threaded_work;
-        let strip_pixels = self.min_strip_pixels.saturating_mul(self.threads() as u64);
-        let dense = pixels < strip_pixels.saturating_mul(triangles);
+        let dense = triangles.saturating_mul(self.threads() as u64)
+            > self.strip_density.saturating_mul(pixels);
         self.spread = match () {
             _ if !S::THREADED || !self.tiled() => Spread::One,
             _ if large && dense => Spread::Bins,

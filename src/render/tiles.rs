@@ -1,9 +1,8 @@
 //! Drawing on several threads, with the frame one thread would draw, bit for bit.
 //!
-//! A small draw, or one of many pixels per triangle, is shared in strips of rows, one
-//! step (`strips`). A large and dense one (below
-//! [`MIN_STRIP_PIXELS`](super::MIN_STRIP_PIXELS) pixels per triangle and thread) runs
-//! in three parallel steps on the renderer's thread pool:
+//! A small draw, or one of up to [`STRIP_DENSITY`](super::STRIP_DENSITY) triangles
+//! per pixel and thread, is shared in strips of rows, one step (`strips`). A large
+//! and denser one runs in three parallel steps on the renderer's thread pool:
 //!
 //! 1. **Vertices**: every vertex goes through the vertex stage and is projected once
 //!    ([`Projected::of`]), in parallel chunks of the vertex array, in one pass

@@ -13,8 +13,8 @@ use termrast::raster::{Target, Traversal};
 use termrast::render::probe::DepthOutcome;
 use termrast::render::target::to_u8;
 use termrast::render::{
-    BAND_ROWS, DENSE_BAND_ROWS, DrawOptions, DrawStats, Isa, MIN_STRIP_PIXELS, MIN_THREADED_WORK,
-    Renderer, Spread, TRIANGLE_WORK, VertexCache, band_rows, project_vertices, strip_ends,
+    BAND_ROWS, DENSE_BAND_ROWS, DrawOptions, DrawStats, Isa, MIN_THREADED_WORK, Renderer,
+    STRIP_DENSITY, Spread, TRIANGLE_WORK, VertexCache, band_rows, project_vertices, strip_ends,
     vertex_spans,
 };
 use termrast::scene::Scene;
@@ -35,7 +35,7 @@ fn share(r: &mut Renderer, way: Spread, parallel_vertices: bool) {
     match way {
         Spread::Bins => {
             r.min_threaded_work = 0;
-            r.min_strip_pixels = u64::MAX;
+            r.strip_density = 0;
         }
         _ => {
             r.min_threaded_work = u64::MAX;
@@ -273,14 +273,15 @@ fn rows_handed_over_mid_draw_keep_one_threads_frame() {
     }
 }
 
-/// With the default thresholds, a large draw goes in strips unless it has fewer than
-/// `MIN_STRIP_PIXELS` pixels per triangle and thread: then it is binned. Whether the
+/// With the default thresholds, a large draw goes in strips unless it has more than
+/// `STRIP_DENSITY` triangles per pixel and thread: then it is binned. Whether the
 /// caller runs on the pool or not, and each frame is one thread's.
 #[test]
 fn large_draws_go_in_strips_unless_dense() {
     let options = (Interpolation::Perspective, Traversal::Wide, Isa::detect());
     for (spec, target, way) in [
         ("sphere:16384", Target::new(1280, 720), Spread::Strips),
+        ("sphere:16384", Target::new(160, 120), Spread::Strips),
         ("sphere:32768", Target::new(96, 64), Spread::Bins),
     ] {
         let scene = model(spec);
@@ -290,7 +291,7 @@ fn large_draws_go_in_strips_unless_dense() {
             work >= MIN_THREADED_WORK,
             "{spec} {target:?} is a large draw"
         );
-        let dense = (target.len() as u64) < MIN_STRIP_PIXELS * 2 * triangles;
+        let dense = 2 * triangles > STRIP_DENSITY * target.len() as u64;
         assert_eq!(dense, way == Spread::Bins, "{spec} {target:?}");
         let mut frame = SceneFrame::new(&scene);
         (frame.interpolation, frame.traversal, frame.renderer.isa) = options;

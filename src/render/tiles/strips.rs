@@ -4,10 +4,10 @@
 //! Binning ([`super::draw`]) sends every set-up record through memory between two
 //! parallel steps. A frame of a few hundred thousand pixels and a few thousand
 //! triangles (a model at terminal size) is done in well under a millisecond, and
-//! binning then costs more than the second thread saves. A larger draw of large
-//! triangles (from [`MIN_STRIP_PIXELS`](crate::render::MIN_STRIP_PIXELS) pixels per
-//! triangle and thread, `Renderer::draw`) is faster in strips too: each triangle is
-//! walked as soon as it is set up, with few borders to cross. Here there is one
+//! binning then costs more than the second thread saves. A larger draw of up to
+//! [`STRIP_DENSITY`](crate::render::STRIP_DENSITY) triangles per pixel and thread
+//! (`Renderer::draw`) is faster in strips too: each triangle is walked as soon as it
+//! is set up, with few borders to cross. Here there is one
 //! step: each thread scans the triangles in draw order, skips those whose box misses
 //! its strip, and sets up and walks the others with their boxes cut to its rows
 //! ([`Setup::rows`](crate::raster::Setup::rows)), as one thread would. Only triangles
@@ -55,7 +55,7 @@ use crate::simd::I32s;
 mod place;
 mod steal;
 
-pub use place::{ALL_ROWS, SHARED_DRAWS, Shares, strip_ends, vertex_spans};
+pub use place::{ALL_ROWS, SHARED_DRAWS, Shares, handover_row, strip_ends, vertex_spans};
 pub(in crate::render) use steal::{Handover, Part};
 
 /// The most strips a draw is cut into: a larger pool leaves its other threads idle.
@@ -139,7 +139,7 @@ pub(in crate::render) fn draw_strip<
         );
         let mut asked = None;
         for t in part.first..n {
-            if handover.asked(part.worker) {
+            if handover.asked(part.worker, t) {
                 asked = Some(t);
                 break;
             }
@@ -277,14 +277,15 @@ pub(in crate::render) unsafe fn draw<T: TileCopy, S: Shader, C: ColorTarget>(
                 }
                 let start = Instant::now();
                 let mut stats = {
-                    let _drawing = handover.drawing(i);
+                    let _drawing = handover.drawing(part);
                     // SAFETY: the caller's guarantee.
                     unsafe { T::strip(&job, &plan, part, &handover, clear) }
                 };
                 let end = u64::try_from(begin.elapsed().as_nanos()).unwrap_or(u64::MAX);
                 ended[i].store(end.max(1), Ordering::Relaxed);
-                while let Some(mut given) = handover.take(i) {
-                    let _drawing = handover.drawing(i);
+                let cut = |rows, next| handover_row(plan.spans, indices, rows, next);
+                while let Some(mut given) = handover.take(i, cut) {
+                    let _drawing = handover.drawing(&given);
                     // SAFETY: the caller's guarantee.
                     stats += unsafe { T::strip(&job, &plan, &mut given, &handover, None) };
                 }

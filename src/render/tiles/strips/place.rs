@@ -177,12 +177,56 @@ pub fn strip_ends(
     (ends, count)
 }
 
+/// Slices a thread's rows are counted in by [`handover_row`].
+const HANDOVER_SLICES: usize = 64;
+
+/// Where to cut rows `first..end` (`first` a multiple of 8) that a thread draws from
+/// triangle `next` on, so that a thread asking for rows gets about half of the work
+/// left there: the block border, leaving a block on each side, nearest the middle of
+/// the triangles left that reach those rows, each counted in the block of its box's
+/// first row there (from `spans`, see [`vertex_spans`]; in up to 64 slices of whole
+/// blocks). 0 when no such border or triangle is left: the rows are then cut in half.
+#[must_use]
+pub fn handover_row(spans: &[u32], indices: &[u32], [first, end]: [u32; 2], next: u32) -> u32 {
+    let blocks = end.saturating_sub(first).div_ceil(8) as usize;
+    if blocks < 2 {
+        return 0;
+    }
+    let per = blocks.div_ceil(HANDOVER_SLICES);
+    let mut hist = [0u32; HANDOVER_SLICES];
+    let start = (next as usize).saturating_mul(3).min(indices.len());
+    for tri in indices[start..].chunks_exact(3) {
+        let span = |k: usize| spans.get(tri[k] as usize).copied().unwrap_or(ALL_ROWS);
+        let (a, b, c) = (span(0), span(1), span(2));
+        let top = (a & 0xffff).min(b & 0xffff).min(c & 0xffff);
+        let bottom = (a >> 16).max(b >> 16).max(c >> 16);
+        if bottom < first || top >= end {
+            continue;
+        }
+        hist[(top.max(first) - first) as usize / 8 / per] += 1;
+    }
+    let total: u32 = hist.iter().sum();
+    let (mut best, mut best_gap, mut seen) = (0, u32::MAX, 0);
+    for (k, &count) in hist.iter().enumerate() {
+        seen += count;
+        let at = first + ((k + 1) * per * 8) as u32;
+        if at + 8 > end {
+            break;
+        }
+        let gap = (2 * seen).abs_diff(total);
+        if gap < best_gap {
+            (best, best_gap) = (at, gap);
+        }
+    }
+    if total == 0 { 0 } else { best }
+}
+
 #[cfg(test)]
 mod tests {
     use glam::Vec4;
     use proptest::prelude::*;
 
-    use super::{ALL_ROWS, MAX_STRIPS, Shares, strip_ends, vertex_spans};
+    use super::{ALL_ROWS, MAX_STRIPS, Shares, handover_row, strip_ends, vertex_spans};
     use crate::raster::Target;
     use crate::raster::clip::{ClipVertex, guard_band_ndc};
     use crate::render::Projected;
@@ -372,6 +416,29 @@ mod tests {
 
     /// Strips cover the target in order, end on multiples of 8 rows (but the last),
     /// and are never empty, whatever the thread count and height.
+    /// A handed-over part starts at the block border that halves the triangles left
+    /// in the rows, counted by their first rows there; triangles drawn already or
+    /// outside the rows do not count, and rows without triangles left, or of fewer
+    /// than two blocks, are cut in half (0).
+    #[test]
+    fn rows_are_handed_over_where_the_work_left_is_halved() {
+        // Vertex i lies on row rows[i]; triangle t is vertex t three times.
+        let rows = [[4; 30].as_slice(), &[44; 10], &[76; 20], &[100; 5]].concat();
+        let spans: Vec<u32> = rows.iter().map(|&r| r | r << 16).collect();
+        let indices: Vec<u32> = (0..rows.len() as u32).flat_map(|t| [t; 3]).collect();
+        // 30 triangles in the first block, 30 below: cut after the first block.
+        assert_eq!(handover_row(&spans, &indices, [0, 80], 0), 8);
+        // Drawn from triangle 30 on: 10 in block 5, 20 in block 9.
+        assert_eq!(handover_row(&spans, &indices, [0, 80], 30), 48);
+        // Rows 40..96: the 10 of row 44 and the 20 of row 76.
+        assert_eq!(handover_row(&spans, &indices, [40, 96], 0), 48);
+        assert_eq!(handover_row(&spans, &indices, [0, 80], 60), 0);
+        assert_eq!(handover_row(&spans, &indices, [0, 15], 0), 0);
+        // A triangle from row 0 to row 100 counts in the first block of any rows.
+        let tall = [100 << 16; 3];
+        assert_eq!(handover_row(&tall, &[0, 1, 2, 0, 1, 2], [48, 96], 0), 56);
+    }
+
     #[test]
     fn strips_cover_the_target_in_blocks_of_rows() {
         for strips in 1..=MAX_STRIPS + 2 {

@@ -63,6 +63,12 @@ const ANSWERED: u8 = 3;
 #[repr(align(128))]
 struct Mailbox<'d, C> {
     state: AtomicU8,
+    /// The next triangle the thread draws.
+    progress: AtomicU32,
+    /// The rows it draws: the first, and the end (exclusive) times 2^16.
+    rows: AtomicU32,
+    /// Where the thread that asks would have the rows cut (0: in half).
+    cut: AtomicU32,
     slot: Mutex<Option<Part<'d, C>>>,
 }
 
@@ -84,6 +90,9 @@ impl<'d, C: SplitOff> Handover<'d, C> {
         Self {
             boxes: std::array::from_fn(|_| Mailbox {
                 state: AtomicU8::new(IDLE),
+                progress: AtomicU32::new(0),
+                rows: AtomicU32::new(0),
+                cut: AtomicU32::new(0),
                 slot: Mutex::new(None),
             }),
             count: count.min(MAX_STRIPS),
@@ -97,38 +106,60 @@ impl<'d, C: SplitOff> Handover<'d, C> {
         u64::from(self.given.load(Ordering::Relaxed))
     }
 
-    /// Thread `worker` starts drawing rows: it may be asked for some until the guard
-    /// is dropped, which [`Handover::finish`]es, also when the drawing panics (so no
+    /// `part`'s thread starts drawing it: it may be asked for rows until the guard is
+    /// dropped, which [`Handover::finish`]es, also when the drawing panics (so no
     /// thread waits for an answer that never comes).
-    pub fn drawing(&self, worker: usize) -> Drawing<'_, 'd, C> {
-        self.start(worker);
+    pub fn drawing(&self, part: &Part<'d, C>) -> Drawing<'_, 'd, C> {
+        self.start(part);
         Drawing {
             handover: self,
-            worker,
+            worker: part.worker,
         }
     }
 
-    /// Thread `worker` starts drawing rows.
-    fn start(&self, worker: usize) {
-        self.boxes[worker].state.store(DRAWING, Ordering::Release);
+    /// `part`'s thread starts drawing it.
+    fn start(&self, part: &Part<'d, C>) {
+        let mailbox = &self.boxes[part.worker];
+        mailbox.progress.store(part.first, Ordering::Relaxed);
+        self.publish_rows(part);
+        mailbox.state.store(DRAWING, Ordering::Release);
     }
 
-    /// Whether another thread asks `worker` for rows: looked at between triangles.
+    /// Says which rows `part`'s thread draws, for a thread about to ask for some.
+    fn publish_rows(&self, part: &Part<'d, C>) {
+        let [first, last] = part.rows();
+        let rows = first.min(0xffff) | (last + 1).min(0xffff) << 16;
+        self.boxes[part.worker].rows.store(rows, Ordering::Relaxed);
+    }
+
+    /// Whether another thread asks `worker`, about to draw triangle `next`, for rows:
+    /// looked at between triangles.
     #[inline(always)]
-    pub fn asked(&self, worker: usize) -> bool {
-        self.boxes[worker].state.load(Ordering::Relaxed) == ASKED
+    pub fn asked(&self, worker: usize, next: u32) -> bool {
+        let mailbox = &self.boxes[worker];
+        mailbox.progress.store(next, Ordering::Relaxed);
+        mailbox.state.load(Ordering::Relaxed) == ASKED
     }
 
-    /// Answers the thread that asked: hands it the lower half of `part`'s rows (in
-    /// whole blocks) to draw from triangle `next` on, or nothing when `part` holds
-    /// fewer than two blocks.
+    /// Answers the thread that asked: hands it `part`'s rows from the block border it
+    /// asked for (or the one in their lower half) to draw from triangle `next` on, or
+    /// nothing when `part` holds fewer than two blocks.
     #[cold]
     #[inline(never)]
     pub fn answer(&self, part: &mut Part<'d, C>, next: u32) {
         let [y0, end] = [part.depth.first_row(), part.depth.end()];
         let rows = end - y0;
+        let mailbox = &self.boxes[part.worker];
+        let asked = mailbox.cut.load(Ordering::Relaxed);
         let given = (rows >= 2 * HANDOVER_ROWS).then(|| {
-            let at = y0 + rows / 2 / HANDOVER_ROWS * HANDOVER_ROWS;
+            let at = if asked.is_multiple_of(HANDOVER_ROWS)
+                && asked >= y0 + HANDOVER_ROWS
+                && asked + HANDOVER_ROWS <= end
+            {
+                asked
+            } else {
+                y0 + rows / 2 / HANDOVER_ROWS * HANDOVER_ROWS
+            };
             let depth = part.depth.split_off(at);
             let color = part.color.split_off((at - y0) as usize * self.width);
             Part {
@@ -140,8 +171,8 @@ impl<'d, C: SplitOff> Handover<'d, C> {
         });
         if given.is_some() {
             self.given.fetch_add(1, Ordering::Relaxed);
+            self.publish_rows(part);
         }
-        let mailbox = &self.boxes[part.worker];
         *mailbox.slot.lock().unwrap_or_else(PoisonError::into_inner) = given;
         mailbox.state.store(ANSWERED, Ordering::Release);
     }
@@ -167,8 +198,10 @@ impl<'d, C: SplitOff> Handover<'d, C> {
 
     /// Rows for thread `worker`, whose own are drawn: asks each other thread that is
     /// drawing in turn, until one hands some over; `None` when none is drawing or all
-    /// that are hold too few rows. The rows are drawn under [`Handover::drawing`].
-    pub fn take(&self, worker: usize) -> Option<Part<'d, C>> {
+    /// that are hold too few rows. `cut` says where it would have the other's rows
+    /// (first and end) cut, given the next triangle the other draws: where the work
+    /// left there is halved. The rows are drawn under [`Handover::drawing`].
+    pub fn take(&self, worker: usize, cut: impl Fn([u32; 2], u32) -> u32) -> Option<Part<'d, C>> {
         let mut declined = 0u32;
         loop {
             let mut busy = false;
@@ -179,6 +212,12 @@ impl<'d, C: SplitOff> Handover<'d, C> {
                 }
                 let mailbox = &self.boxes[other];
                 let state = &mailbox.state;
+                if state.load(Ordering::Acquire) == DRAWING {
+                    let rows = mailbox.rows.load(Ordering::Relaxed);
+                    let next = mailbox.progress.load(Ordering::Relaxed);
+                    let at = cut([rows & 0xffff, rows >> 16], next);
+                    mailbox.cut.store(at, Ordering::Relaxed);
+                }
                 match state.compare_exchange(DRAWING, ASKED, Ordering::AcqRel, Ordering::Relaxed) {
                     Ok(_) => {
                         while state.load(Ordering::Acquire) != ANSWERED {
@@ -245,12 +284,12 @@ mod tests {
         let mut t = part.first;
         while t < n {
             if wait && t == n / 2 {
-                while !handover.asked(part.worker) {
+                while !handover.asked(part.worker, t) {
                     std::hint::spin_loop();
                 }
                 wait = false;
             }
-            if handover.asked(part.worker) {
+            if handover.asked(part.worker, t) {
                 handover.answer(part, t);
                 part.first = t;
                 continue;
@@ -302,7 +341,7 @@ mod tests {
                     let (handover, started) = (&handover, &started);
                     s.spawn(move || {
                         let worker = part.worker;
-                        handover.start(worker);
+                        handover.start(&part);
                         if worker == 0 {
                             started.store(true, Ordering::Release);
                         } else {
@@ -313,9 +352,12 @@ mod tests {
                         }
                         draw(&mut part, handover, n, worker == 0);
                         handover.finish(worker);
-                        while let Some(mut given) = handover.take(worker) {
+                        // Cuts asked for anywhere, some of them not at a block border
+                        // or leaving a side without a block: those are cut in half.
+                        let cut = |[y0, end]: [u32; 2], next: u32| y0 + next % (end - y0 + 1);
+                        while let Some(mut given) = handover.take(worker, cut) {
                             assert_eq!(given.worker, worker);
-                            let _drawing = handover.drawing(worker);
+                            let _drawing = handover.drawing(&given);
                             draw(&mut given, handover, n, false);
                         }
                     });
@@ -328,15 +370,21 @@ mod tests {
         }
     }
 
-    /// A part is cut at a block border in its lower half, and one of fewer than two
-    /// blocks is not cut: the thread that asked gets nothing.
+    /// A part is cut where the thread that asked would have it if that is a block
+    /// border leaving a block on each side, else at a block border in its lower half;
+    /// one of fewer than two blocks is not cut: the thread that asked gets nothing.
     #[test]
     fn a_part_is_cut_in_whole_blocks_or_not_at_all() {
-        for (y0, rows, cut) in [
-            (8, 40, Some(24)),
-            (16, 16, Some(24)),
-            (0, 15, None),
-            (8, 23, Some(16)),
+        for (y0, rows, ask, cut) in [
+            (8, 40, 0, Some(24)),
+            (8, 40, 40, Some(40)),
+            (8, 40, 16, Some(16)),
+            (8, 40, 44, Some(24)),
+            (8, 40, 8, Some(24)),
+            (8, 40, 48, Some(24)),
+            (16, 16, 24, Some(24)),
+            (0, 15, 8, None),
+            (8, 23, 0, Some(16)),
         ] {
             let mut color = vec![[0u8; 4]; 3 * (y0 + rows) as usize];
             let mut depth = DepthBuffer::new(3, y0 + rows);
@@ -352,14 +400,17 @@ mod tests {
                 worker: 1,
             };
             let handover: Handover<'_, Rgba8Rows<'_>> = Handover::new(2, 3);
-            handover.start(1);
+            handover.start(&part);
             let asked = std::thread::scope(|s| {
                 let thief = s.spawn(|| {
                     handover
-                        .take(0)
+                        .take(0, |seen, next| {
+                            assert_eq!((seen, next), ([y0, y0 + rows], 5));
+                            ask
+                        })
                         .map(|p| (p.rows(), p.first, p.color.0.len(), p.worker))
                 });
-                while !handover.asked(1) {
+                while !handover.asked(1, 5) {
                     std::hint::spin_loop();
                 }
                 handover.answer(&mut part, 7);

@@ -181,6 +181,7 @@ impl<'d, C: SplitOff> Handover<'d, C> {
     /// nothing, and waits for one that was answered to take the answer.
     fn finish(&self, worker: usize) {
         let state = &self.boxes[worker].state;
+        let mut spins = 0;
         loop {
             match state.compare_exchange(DRAWING, IDLE, Ordering::AcqRel, Ordering::Acquire) {
                 Ok(_) | Err(IDLE) => return,
@@ -191,7 +192,7 @@ impl<'d, C: SplitOff> Handover<'d, C> {
                         .unwrap_or_else(PoisonError::into_inner) = None;
                     state.store(ANSWERED, Ordering::Release);
                 }
-                Err(_) => spin_loop(),
+                Err(_) => wait(&mut spins),
             }
         }
     }
@@ -220,8 +221,9 @@ impl<'d, C: SplitOff> Handover<'d, C> {
                 }
                 match state.compare_exchange(DRAWING, ASKED, Ordering::AcqRel, Ordering::Relaxed) {
                     Ok(_) => {
+                        let mut spins = 0;
                         while state.load(Ordering::Acquire) != ANSWERED {
-                            spin_loop();
+                            wait(&mut spins);
                         }
                         let given = mailbox
                             .slot
@@ -247,6 +249,18 @@ impl<'d, C: SplitOff> Handover<'d, C> {
             }
             spin_loop();
         }
+    }
+}
+
+/// One round of waiting for another thread's answer, which comes within a triangle:
+/// spinning at first, then yielding, in case the other thread waits for this one's
+/// core.
+fn wait(spins: &mut u32) {
+    *spins += 1;
+    if *spins < 1 << 12 {
+        spin_loop();
+    } else {
+        std::thread::yield_now();
     }
 }
 

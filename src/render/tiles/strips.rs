@@ -21,9 +21,10 @@
 //! draw): at first each holds as many, then each draw's shares are corrected by the
 //! time each strip took to end ([`Shares`]), since a vertex costs more where its
 //! triangles are larger or the other thread starts later. Within a draw, a thread
-//! done with its rows takes the lower half of another's, which goes on from the next
-//! triangle with the rest (`steal`): so the threads end together even when a core
-//! slows down mid-draw. A small frame is worth
+//! done with its rows takes the lower part of another's, where about half of its
+//! work left lies, and the other goes on from the next triangle with the rest
+//! (`steal`): so the threads end together even when a core slows down mid-draw. A
+//! small frame is worth
 //! strips only to a caller that runs on the pool's threads itself
 //! (`Renderer::plan_frame`): handing a frame of a few hundred microseconds to a
 //! sleeping thread and waiting for it to be handed back costs more than the second
@@ -102,7 +103,7 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> StripWalk<S::Varying>
 
 /// Draws `part`'s rows (its colour and depth) of every triangle of the draw from its
 /// first on, first filling the colour rows with `clear` if given, with variant `V` on
-/// lanes `L`; hands the lower half of its rows to a thread that asks for them
+/// lanes `L`; hands the lower part of its rows to a thread that asks for them
 /// (`handover`) and goes on with the rest. Returns the rows' counters. The body of
 /// every copy's [`TileCopy::strip`].
 #[inline(always)]

@@ -1,6 +1,6 @@
-//! Rows handed over while the strips are drawn: a thread whose strip is done asks a
-//! thread still drawing for half of its rows, and the two go on from the next
-//! triangle.
+//! Rows handed over while the strips are drawn: a thread whose rows are done asks a
+//! thread still drawing for the part of its rows that holds about half of its work
+//! left, and the two go on from the next triangle.
 //!
 //! A strip's share is fixed for the draw, and the other core's speed wanders on a
 //! shared machine, so strips rarely end together. A handover keeps the frame one
@@ -12,9 +12,10 @@
 //! before the second's.
 //!
 //! Each thread of the draw has a mailbox whose state says whether it is drawing,
-//! asked, or has answered. The drawing thread looks at its own state once per
-//! triangle (one load of a line no one else writes until it asks); everything else
-//! happens only when a thread runs out of rows.
+//! asked, or has answered. The drawing thread stores its progress and looks at its
+//! state once per triangle (a line no one else writes until it asks); the asking
+//! thread reads the progress and the rows to choose the cut (`handover_row`).
+//! Everything else happens only when a thread runs out of rows.
 
 use std::hint::spin_loop;
 use std::sync::atomic::{AtomicU8, AtomicU32, Ordering};

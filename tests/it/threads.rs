@@ -226,13 +226,27 @@ fn strips_frame_after_frame_equal_one_thread() {
             5 => frame.renderer.set_strip_shares(0, &[0.9, 0.1]),
             _ => {}
         }
-        let view = turned(0.3 * n as f32);
-        pool.install(|| frame.draw(&scene, target, &view));
-        assert_eq!(frame.renderer.spread(), Spread::Strips);
-        let many = bits(&frame);
-        let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
-        assert!(one == many, "frame {n}");
+        strips_frame_is_one_threads(&mut frame, &pool, &scene, target, n, options);
     }
+}
+
+/// Draws frame `n` of `scene` turning, on `pool` in strips, and checks that it is one
+/// thread's.
+fn strips_frame_is_one_threads(
+    frame: &mut SceneFrame,
+    pool: &rayon::ThreadPool,
+    scene: &Scene,
+    target: Target,
+    n: u32,
+    options: (Interpolation, Traversal, Isa),
+) {
+    let view = turned(0.3 * n as f32);
+    pool.install(|| frame.draw(scene, target, &view));
+    assert_eq!(frame.renderer.spread(), Spread::Strips);
+    let many = bits(frame);
+    let one = frame_bits(scene, target, &view, options, 1, Spread::One);
+    let threads = frame.renderer.threads();
+    assert!(one == many, "{options:?} on {threads} threads, frame {n}");
 }
 
 /// A thread done with its strip takes rows from one still drawing, mid-draw: with
@@ -257,12 +271,7 @@ fn rows_handed_over_mid_draw_keep_one_threads_frame() {
                 shares[0] = 1.0;
                 for n in 0..8 {
                     frame.renderer.set_strip_shares(0, &shares);
-                    let view = turned(0.3 * n as f32);
-                    pool.install(|| frame.draw(&scene, target, &view));
-                    assert_eq!(frame.renderer.spread(), Spread::Strips);
-                    let many = bits(&frame);
-                    let one = frame_bits(&scene, target, &view, options, 1, Spread::One);
-                    assert!(one == many, "{options:?} {threads} threads, frame {n}");
+                    strips_frame_is_one_threads(&mut frame, &pool, &scene, target, n, options);
                 }
                 assert!(
                     frame.renderer.handovers() > 0,

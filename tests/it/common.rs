@@ -3,7 +3,7 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 use termrast::raster::{CountGrid, CoverageSink, Setup, Target, Traversal, oracle};
-use termrast::render::target::split_slice;
+use termrast::render::target::{split_off_slice, split_slice};
 use termrast::render::{
     ColorTarget, DrawOptions, Renderer, Shader, SplitOff, VertexCache, transform,
 };
@@ -140,13 +140,9 @@ pub struct ExactRows<'a> {
 
 impl SplitOff for ExactRows<'_> {
     fn split_off(&mut self, pixels: usize) -> Self {
-        let at = pixels.min(self.colors.len());
-        let (colors, colors_rest) = std::mem::take(&mut self.colors).split_at_mut(at);
-        let (writes, writes_rest) = std::mem::take(&mut self.writes).split_at_mut(at);
-        (self.colors, self.writes) = (colors, writes);
         ExactRows {
-            colors: colors_rest,
-            writes: writes_rest,
+            colors: split_off_slice(&mut self.colors, pixels),
+            writes: split_off_slice(&mut self.writes, pixels),
         }
     }
 }

@@ -56,7 +56,7 @@ use crate::simd::I32s;
 mod place;
 mod steal;
 
-pub use place::{ALL_ROWS, SHARED_DRAWS, Shares, handover_row, strip_ends, vertex_spans};
+pub use place::{ALL_ROWS, SHARED_DRAWS, Shares, box_rows, handover_row, strip_ends, vertex_spans};
 pub(in crate::render) use steal::{Handover, Part};
 
 /// The most strips a draw is cut into: a larger pool leaves its other threads idle.
@@ -145,8 +145,7 @@ pub(in crate::render) fn draw_strip<
                 break;
             }
             let base = t as usize * 3;
-            let span = |k: usize| spans.get(indices[base + k] as usize).copied();
-            let (Some(a), Some(b), Some(c)) = (span(0), span(1), span(2)) else {
+            let Some([top, bottom]) = box_rows(spans, &indices[base..base + 3]) else {
                 // A vertex out of range: rejected, counted by the rows from the top.
                 if y0 == 0 {
                     stats.triangles += 1;
@@ -155,8 +154,6 @@ pub(in crate::render) fn draw_strip<
                 continue;
             };
             // The box's first row (clamped to the target) is in its owner's rows.
-            let top = (a & 0xffff).min(b & 0xffff).min(c & 0xffff);
-            let bottom = (a >> 16).max(b >> 16).max(c >> 16);
             // 1 for the owner, added to its counters without a branch: a branch on it
             // after the set-up made the compiler copy the whole set-up and walk for
             // each side.

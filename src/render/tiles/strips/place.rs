@@ -108,6 +108,20 @@ pub fn vertex_spans(projected: &[Projected], height: u32, spans: &mut Vec<u32>) 
     }));
 }
 
+/// The first and last row of the box of the triangle with vertices `tri` (clamped to
+/// the target), from their [`vertex_spans`]: a box is monotone in its vertices, so
+/// these are the least first row and the greatest last row of the three. `None` for
+/// a vertex index out of range.
+#[inline(always)]
+#[must_use]
+pub fn box_rows(spans: &[u32], tri: &[u32]) -> Option<[u32; 2]> {
+    let span = |k: usize| spans.get(*tri.get(k)? as usize).copied();
+    let (a, b, c) = (span(0)?, span(1)?, span(2)?);
+    let top = (a & 0xffff).min(b & 0xffff).min(c & 0xffff);
+    let bottom = (a >> 16).max(b >> 16).max(c >> 16);
+    Some([top, bottom])
+}
+
 /// Where the strips of a target `height` rows high end, one per entry of `shares`,
 /// each a multiple of 8 rows but the last, so that each holds about its share of the
 /// vertices (by their first rows in `spans`, see [`vertex_spans`]; `hist` is
@@ -196,10 +210,10 @@ pub fn handover_row(spans: &[u32], indices: &[u32], [first, end]: [u32; 2], next
     let mut hist = [0u32; HANDOVER_SLICES];
     let start = (next as usize).saturating_mul(3).min(indices.len());
     for tri in indices[start..].chunks_exact(3) {
-        let span = |k: usize| spans.get(tri[k] as usize).copied().unwrap_or(ALL_ROWS);
-        let (a, b, c) = (span(0), span(1), span(2));
-        let top = (a & 0xffff).min(b & 0xffff).min(c & 0xffff);
-        let bottom = (a >> 16).max(b >> 16).max(c >> 16);
+        // A triangle with a vertex out of range is drawn nowhere.
+        let Some([top, bottom]) = box_rows(spans, tri) else {
+            continue;
+        };
         if bottom < first || top >= end {
             continue;
         }

@@ -332,6 +332,17 @@ impl Scene {
         self.replan();
     }
 
+    /// Draws every object in its material's colour alone, without its model's vertex
+    /// colours (`bench render --no-vertex-colors`), and plans again. Before any frame
+    /// is made for the scene: its pipelines change.
+    pub fn drop_vertex_colors(&mut self) {
+        for o in &mut self.objects {
+            o.desc.material.vertex_colors = false;
+            std::sync::Arc::make_mut(&mut o.mesh).colors = Vec::new();
+        }
+        self.replan();
+    }
+
     /// The plan again after an effect changed, and the edges of objects that now draw
     /// them. Only effects drawn outside the shader may change (fill, wireframe,
     /// culling), so the pipelines chosen by the old plan still fit

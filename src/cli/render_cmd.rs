@@ -128,6 +128,11 @@ pub struct BenchRenderArgs {
     /// been faster on, as the viewer does (by default every frame uses the threads).
     #[arg(long)]
     pub measured: bool,
+    /// Draw the model in its material's colour alone, without its vertex colours
+    /// (`sphere:N` then is white): per-pixel Lambert without the colour's four
+    /// varyings.
+    #[arg(long)]
+    pub no_vertex_colors: bool,
     /// Thread counts to compare in one run, e.g. `1,2`: each round draws `--frames`
     /// frames with each count in turn, back to back, so a machine's slow spells hit
     /// them alike; prints each round and each count's speed-up over the first (the
@@ -273,7 +278,7 @@ fn write_png(path: &Path, color: &Rgba8, target: Target) -> Result<(), super::Cl
 }
 
 /// The result of the standard benchmark.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct BenchReport {
     pub median_ms: f64,
     pub min_ms: f64,
@@ -284,6 +289,8 @@ pub struct BenchReport {
     pub isa: Isa,
     /// The threads it drew on.
     pub threads: usize,
+    /// The shading each object was drawn with ([`SceneFrame::pipelines`]), joined by `+`.
+    pub shading: String,
 }
 
 impl std::fmt::Display for BenchReport {
@@ -292,14 +299,15 @@ impl std::fmt::Display for BenchReport {
         write!(
             f,
             "median_ms={:.3} min_ms={:.3} triangles={} covered_px={} mpx_per_s={:.1} isa={} \
-             threads={}",
+             threads={} shading={}",
             self.median_ms,
             self.min_ms,
             self.triangles,
             self.covered_px,
             mpx,
             self.isa.name(),
-            self.threads
+            self.threads,
+            self.shading
         )
     }
 }
@@ -326,6 +334,9 @@ fn bench_scene(args: &BenchRenderArgs) -> Result<Scene, super::CliError> {
     super::view_cmd::print_warnings(&scene.warnings, &mut std::io::stderr().lock());
     scene.set_mode(args.scene.mode);
     scene.set_cull(args.scene.cull);
+    if args.no_vertex_colors {
+        scene.drop_vertex_colors();
+    }
     Ok(scene)
 }
 
@@ -383,6 +394,7 @@ fn report(scene: &Scene, frame: &SceneFrame, times: &[f64], covered_px: u64) -> 
         covered_px,
         isa: frame.renderer.copy_for::<Lambert<'_>>(&opts).isa,
         threads: frame.renderer.threads(),
+        shading: frame.pipelines().join("+"),
     }
 }
 

@@ -295,6 +295,34 @@ fn bench_render_reports_and_checks_its_instruction_set() {
     }
 }
 
+/// `bench render` names the shading it drew with: the sphere in its vertex colours,
+/// or with `--no-vertex-colors` white, covering the same fragments.
+#[test]
+fn bench_render_names_its_shading_and_can_leave_vertex_colours_out() {
+    let field = |out: &str, key: &str| {
+        out.split_whitespace()
+            .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+            .map(str::to_owned)
+            .unwrap_or_else(|| panic!("no {key} in {out}"))
+    };
+    let run = |model: &str, extra: &[&str]| {
+        let mut args = vec!["bench", "render", model, "--size", "96x64", "--frames", "2"];
+        args.extend(extra);
+        let (ok, out, err) = termrast(&args);
+        assert!(ok, "{err}");
+        (field(&out, "shading"), field(&out, "covered_px"))
+    };
+    let (coloured, covered) = run("sphere:2000", &[]);
+    assert_eq!(coloured, "lambert-colors");
+    assert_ne!(covered, "0");
+    let white = run("sphere:2000", &["--no-vertex-colors"]);
+    assert_eq!(white, ("lambert".to_owned(), covered));
+    // The teapot has no vertex colours: the flag changes nothing.
+    let teapot = run("teapot", &[]);
+    assert_eq!(teapot.0, "lambert");
+    assert_eq!(run("teapot", &["--no-vertex-colors"]), teapot);
+}
+
 /// `bench render --compare` draws with each thread count in turn, round by round, and
 /// sums up each count's medians and its speed-up over the first; it refuses
 /// `--threads` beside it and `--rounds` without it.

@@ -355,6 +355,35 @@ fn the_standard_plan_takes_the_lambert_pipeline() {
     }
 }
 
+/// Pass: a model's scene without its vertex colours (`bench render
+/// --no-vertex-colors`) takes the plain Lambert pipeline, and draws the sphere's
+/// pixels at the same depths as with them, in grey (a white material under white
+/// lights) where with them they are coloured.
+#[test]
+fn a_model_without_its_vertex_colours_is_drawn_white() {
+    let target = Target::new(160, 120);
+    let coloured = Scene::standard("sphere:2000").unwrap();
+    let mut white = coloured.clone();
+    white.drop_vertex_colors();
+    assert!(white.objects[0].mesh.colors.is_empty());
+    let mut frames = [&coloured, &white].map(|scene| {
+        let mut frame = SceneFrame::new(scene);
+        frame.draw(scene, target, &SceneView::default());
+        frame
+    });
+    assert_eq!(frames[0].pipelines(), ["lambert-colors"]);
+    assert_eq!(frames[1].pipelines(), ["lambert"]);
+    let [c, w] = &mut frames;
+    assert_eq!(c.renderer.depth.to_vec(), w.renderer.depth.to_vec());
+    let covered = |p: &[u8; 4]| p[3] == 255;
+    let grey = |p: &[u8; 4]| p[0] == p[1] && p[1] == p[2];
+    let pairs = || c.color.0.iter().zip(&w.color.0);
+    assert!(pairs().all(|(a, b)| covered(a) == covered(b)));
+    assert!(pairs().filter(|(a, _)| covered(a)).count() > 5000);
+    assert!(pairs().all(|(_, b)| !covered(b) || grey(b)));
+    assert!(pairs().filter(|(a, _)| covered(a) && !grey(a)).count() > 5000);
+}
+
 /// Pass: `fill = false` draws an object's edges and nothing of its triangles: the plan
 /// says so, there is no depth buffer, every pixel drawn is a wire pixel, and no
 /// fragment is depth-tested or lit. Filling it again (the viewer's `w`) gives the plan

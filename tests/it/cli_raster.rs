@@ -241,16 +241,18 @@ fn line_command_rejects_bad_input() {
     assert_eq!(out, "0,0 1,1 2,1 3,1 4,1 5,1 6,1 7,1\n");
 }
 
+/// The value of `key=value` in a `bench render` report.
+fn report_field(out: &str, key: &str) -> String {
+    out.split_whitespace()
+        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+        .map(str::to_owned)
+        .unwrap_or_else(|| panic!("no {key} in {out}"))
+}
+
 /// `bench render` runs on the instruction set it is given, reports it, and covers the
 /// same fragments on each; it refuses a name it does not know and one the CPU lacks.
 #[test]
 fn bench_render_reports_and_checks_its_instruction_set() {
-    let field = |out: &str, key: &str| {
-        out.split_whitespace()
-            .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
-            .map(str::to_owned)
-            .unwrap_or_else(|| panic!("no {key} in {out}"))
-    };
     let mut covered = Vec::new();
     for isa in Isa::supported() {
         let (ok, out, err) = termrast(&[
@@ -265,8 +267,8 @@ fn bench_render_reports_and_checks_its_instruction_set() {
             isa.name(),
         ]);
         assert!(ok, "{err}");
-        assert_eq!(field(&out, "isa"), isa.name());
-        covered.push(field(&out, "covered_px"));
+        assert_eq!(report_field(&out, "isa"), isa.name());
+        covered.push(report_field(&out, "covered_px"));
     }
     assert!(covered.windows(2).all(|w| w[0] == w[1]), "{covered:?}");
     assert_ne!(covered[0], "0");
@@ -285,7 +287,7 @@ fn bench_render_reports_and_checks_its_instruction_set() {
             "scalar",
         ]);
         assert!(ok, "{err}");
-        assert_eq!(field(&out, "isa"), "avx2");
+        assert_eq!(report_field(&out, "isa"), "avx2");
     }
     let (ok, _, err) = termrast(&["bench", "render", "--frames", "1", "--isa", "sse9"]);
     assert!(!ok && err.contains("baseline, avx2, avx512"), "{err}");
@@ -299,18 +301,15 @@ fn bench_render_reports_and_checks_its_instruction_set() {
 /// or with `--no-vertex-colors` white, covering the same fragments.
 #[test]
 fn bench_render_names_its_shading_and_can_leave_vertex_colours_out() {
-    let field = |out: &str, key: &str| {
-        out.split_whitespace()
-            .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
-            .map(str::to_owned)
-            .unwrap_or_else(|| panic!("no {key} in {out}"))
-    };
     let run = |model: &str, extra: &[&str]| {
         let mut args = vec!["bench", "render", model, "--size", "96x64", "--frames", "2"];
         args.extend(extra);
         let (ok, out, err) = termrast(&args);
         assert!(ok, "{err}");
-        (field(&out, "shading"), field(&out, "covered_px"))
+        (
+            report_field(&out, "shading"),
+            report_field(&out, "covered_px"),
+        )
     };
     let (coloured, covered) = run("sphere:2000", &[]);
     assert_eq!(coloured, "lambert-colors");

@@ -344,8 +344,9 @@ impl Scene {
     }
 
     /// The plan again after an effect changed, and the edges of objects that now draw
-    /// them. Only effects drawn outside the shader may change (fill, wireframe,
-    /// culling), so the pipelines chosen by the old plan still fit
+    /// them. Once frames are made for the scene, only effects drawn outside the shader
+    /// may change (fill, wireframe, culling), so the pipelines chosen by the old plan
+    /// still fit
     /// ([`render::is_standard_lambert`] ignores them) and nothing loaded is missing
     /// but edges.
     fn replan(&mut self) {

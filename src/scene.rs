@@ -346,9 +346,8 @@ impl Scene {
     /// The plan again after an effect changed, and the edges of objects that now draw
     /// them. Once frames are made for the scene, only effects drawn outside the shader
     /// may change (fill, wireframe, culling), so the pipelines chosen by the old plan
-    /// still fit
-    /// ([`render::is_standard_lambert`] ignores them) and nothing loaded is missing
-    /// but edges.
+    /// still fit ([`render::is_standard_lambert`] ignores them) and nothing loaded is
+    /// missing but edges.
     fn replan(&mut self) {
         let descs: Vec<ObjectDesc> = self.objects.iter().map(|o| o.desc.clone()).collect();
         self.plan = Plan::new(&descs, &self.lights, self.plan.samples);

@@ -56,7 +56,9 @@ use crate::simd::I32s;
 mod place;
 mod steal;
 
-pub use place::{ALL_ROWS, SHARED_DRAWS, Shares, box_rows, handover_row, strip_ends, vertex_spans};
+pub use place::{
+    ALL_ROWS, SHARED_DRAWS, Shares, box_rows, handover_row, reaching, strip_ends, vertex_spans,
+};
 pub(in crate::render) use steal::{Handover, Part};
 
 /// The most strips a draw is cut into: a larger pool leaves its other threads idle.
@@ -101,6 +103,9 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> StripWalk<S::Varying>
     }
 }
 
+/// Triangles a strip scans at a time for those that reach its rows ([`reaching`]).
+const SCAN_BLOCK: u32 = 64;
+
 /// Draws `part`'s rows (its colour and depth) of every triangle of the draw from its
 /// first on, first filling the colour rows with `clear` if given, with variant `V` on
 /// lanes `L`; hands the lower part of its rows to a thread that asks for them
@@ -139,43 +144,57 @@ pub(in crate::render) fn draw_strip<
             job.target,
         );
         let mut asked = None;
-        for t in part.first..n {
-            if handover.asked(part.worker, t) {
-                asked = Some(t);
+        let mut block = part.first;
+        'scan: while block < n {
+            if handover.asked(part.worker, block) {
+                asked = Some(block);
                 break;
             }
-            let base = t as usize * 3;
-            let Some([top, bottom]) = box_rows(spans, &indices[base..base + 3]) else {
-                // A vertex out of range: rejected, counted by the rows from the top.
-                if y0 == 0 {
-                    stats.triangles += 1;
-                    stats.rejected += 1;
+            // The triangles of the next block that these rows draw or count, found in
+            // a tight loop: the many that miss a strip then cost a few instructions
+            // each and no mispredicted branch.
+            let end = n.min(block + SCAN_BLOCK);
+            let tris = &indices[block as usize * 3..end as usize * 3];
+            let mut reach = reaching(spans, tris, [y0, y1]);
+            let first = block;
+            block = end;
+            while reach != 0 {
+                let t = first + reach.trailing_zeros();
+                reach &= reach - 1;
+                if handover.asked(part.worker, t) {
+                    asked = Some(t);
+                    break 'scan;
                 }
-                continue;
-            };
-            // The box's first row (clamped to the target) is in its owner's rows.
-            // 1 for the owner, added to its counters without a branch: a branch on it
-            // after the set-up made the compiler copy the whole set-up and walk for
-            // each side.
-            let owner = u64::from((y0..=y1).contains(&top));
-            if owner == 0 && (bottom < y0 || top > y1) {
-                continue;
+                let base = t as usize * 3;
+                let Some([top, _]) = box_rows(spans, &indices[base..base + 3]) else {
+                    // A vertex out of range: rejected, counted by the rows from the top.
+                    if y0 == 0 {
+                        stats.triangles += 1;
+                        stats.rejected += 1;
+                    }
+                    continue;
+                };
+                // The box reaches these rows, or its first row (clamped to the target)
+                // is in them: its owner's. 1 for the owner, added to its counters
+                // without a branch: a branch on it after the set-up made the compiler
+                // copy the whole set-up and walk for each side.
+                let owner = u64::from((y0..=y1).contains(&top));
+                let mut cut = Cut {
+                    walker: &mut walker,
+                    rows: [y0, y1],
+                };
+                let (cache, target) = (job.cache, job.target);
+                let outcome = prepare_projected(
+                    cache,
+                    Some(projected),
+                    indices,
+                    t,
+                    target,
+                    &job.opts,
+                    &mut cut,
+                );
+                outcome.count(&mut stats, owner);
             }
-            let mut cut = Cut {
-                walker: &mut walker,
-                rows: [y0, y1],
-            };
-            let (cache, target) = (job.cache, job.target);
-            let outcome = prepare_projected(
-                cache,
-                Some(projected),
-                indices,
-                t,
-                target,
-                &job.opts,
-                &mut cut,
-            );
-            outcome.count(&mut stats, owner);
         }
         stats.fragments += walker.stats.fragments;
         stats.shaded += walker.stats.shaded;

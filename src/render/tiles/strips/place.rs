@@ -122,6 +122,22 @@ pub fn box_rows(spans: &[u32], tri: &[u32]) -> Option<[u32; 2]> {
     Some([top, bottom])
 }
 
+/// Bit `k` set for triangle `k` of `tris` (at most 64) if rows `[first, last]` draw
+/// it or count it ([`box_rows`]): its box reaches them, or its first row is in them
+/// (a box that holds no row, its first after its last, is counted there), or it has
+/// no box from the spans (every strip sets it up, or counts it as out of range).
+#[inline(always)]
+#[must_use]
+pub fn reaching(spans: &[u32], tris: &[u32], [first, last]: [u32; 2]) -> u64 {
+    let mut bits = 0;
+    for (k, tri) in tris.chunks_exact(3).take(64).enumerate() {
+        let hit =
+            box_rows(spans, tri).is_none_or(|[top, end]| top <= last && top.max(end) >= first);
+        bits |= u64::from(hit) << k;
+    }
+    bits
+}
+
 /// Where the strips of a target `height` rows high end, one per entry of `shares`,
 /// each a multiple of 8 rows but the last, so that each holds about its share of the
 /// vertices (by their first rows in `spans`, see [`vertex_spans`]; `hist` is
@@ -240,12 +256,36 @@ mod tests {
     use glam::Vec4;
     use proptest::prelude::*;
 
-    use super::{ALL_ROWS, MAX_STRIPS, Shares, handover_row, strip_ends, vertex_spans};
+    use super::{ALL_ROWS, MAX_STRIPS, Shares, handover_row, reaching, strip_ends, vertex_spans};
     use crate::raster::Target;
     use crate::raster::clip::{ClipVertex, guard_band_ndc};
     use crate::render::Projected;
     use crate::render::options::DrawOptions;
     use crate::render::prepare::{PrepareOutcome, Prepared, VertexCache, prepare_projected};
+
+    /// A strip's rows reach the triangles whose box meets them, those whose box's
+    /// first row they hold (a box without a row is counted there alone), and every
+    /// triangle without a box from the spans; at most 64 at a time.
+    #[test]
+    fn rows_reach_the_triangles_they_draw_or_count() {
+        let span = |first: u32, last: u32| first | last << 16;
+        // Rows 2–5, rows 10–12, a point's box between rows 6 and 7, all rows.
+        let spans = [span(2, 5), span(10, 12), span(7, 6), ALL_ROWS];
+        // The last has a vertex index out of range.
+        let tris = [0, 0, 0, 1, 1, 1, 2, 2, 2, 0, 3, 0, 0, 1, 9];
+        for (rows, bits) in [
+            ([6, 9], 0b11100),
+            ([0, 5], 0b11001),
+            ([8, 20], 0b11010),
+            ([7, 7], 0b11100),
+            ([0, 0], 0b11000),
+            ([12, 12], 0b11010),
+        ] {
+            assert_eq!(reaching(&spans, &tris, rows), bits, "rows {rows:?}");
+        }
+        let many = [3; 70 * 3];
+        assert_eq!(reaching(&spans, &many, [0, 0]).count_ones(), 64);
+    }
 
     /// Each strip ends at the 8-row block border nearer to where the strips so far
     /// hold their share of the vertices; vertices off the target count at its nearest

@@ -8,8 +8,9 @@
 //! [`STRIP_DENSITY`](crate::render::STRIP_DENSITY) triangles per pixel and thread
 //! (`Renderer::draw`) is faster in strips too: each triangle is walked as soon as it
 //! is set up, with few borders to cross. Here there is one
-//! step: each thread scans the triangles in draw order, skips those whose box misses
-//! its strip, and sets up and walks the others with their boxes cut to its rows
+//! step: each thread scans the triangles in draw order, 64 at a time in a tight loop
+//! ([`reaching`]), skips those whose box misses its strip, and sets up and walks the
+//! others with their boxes cut to its rows
 //! ([`Setup::rows`](crate::raster::Setup::rows)), as one thread would. Only triangles
 //! crossing a strip's border are set up twice. The scan reads one word per vertex,
 //! the rows a box takes from it ([`vertex_spans`]), made once before the strips

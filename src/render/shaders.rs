@@ -226,15 +226,15 @@ impl Shader for ColoredLambert<'_> {
         w: &[F; 3],
         _mask: u32,
     ) -> ShadeLanes<F> {
+        // Through `black_box`, the 21 vertex terms are loaded and broadcast for each
+        // group: otherwise the compiler hoists their broadcasts out of the group loop,
+        // has too few vector registers for them, and spills each as a 64-byte vector
+        // per triangle (see docs/performance.md, "The coloured Lambert's terms").
         let [
             (Direction(na), ha),
             (Direction(nb), hb),
             (Direction(nc), hc),
         ] = *std::hint::black_box(rel);
-        // Through `black_box`, the 21 vertex terms are loaded and broadcast for each
-        // group: otherwise the compiler hoists their broadcasts out of the group loop,
-        // has too few vector registers for them, and spills each as a 64-byte vector
-        // per triangle (see docs/performance.md, "The coloured Lambert's terms").
         let n = each3!(|i| weigh_lanes([na[i], nb[i], nc[i]], w));
         let h = each3!(|i| weigh_lanes([ha.scaled[i], hb.scaled[i], hc.scaled[i]], w));
         let weight = weigh_lanes([ha.weight, hb.weight, hc.weight], w);

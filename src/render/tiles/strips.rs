@@ -104,8 +104,9 @@ impl<S: Shader, C: ColorTarget, L: I32s, V: DrawVariant> StripWalk<S::Varying>
     }
 }
 
-/// Triangles a strip scans at a time for those that reach its rows ([`reaching`]).
-const SCAN_BLOCK: u32 = 64;
+/// Triangles a strip scans at a time for those that reach its rows: a bit each in
+/// [`reaching`]'s word.
+const SCAN_BLOCK: u32 = u64::BITS;
 
 /// Draws `part`'s rows (its colour and depth) of every triangle of the draw from its
 /// first on, first filling the colour rows with `clear` if given, with variant `V` on

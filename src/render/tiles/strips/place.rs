@@ -130,7 +130,7 @@ pub fn box_rows(spans: &[u32], tri: &[u32]) -> Option<[u32; 2]> {
 #[must_use]
 pub fn reaching(spans: &[u32], tris: &[u32], [first, last]: [u32; 2]) -> u64 {
     let mut bits = 0;
-    for (k, tri) in tris.chunks_exact(3).take(64).enumerate() {
+    for (k, tri) in tris.chunks_exact(3).take(u64::BITS as usize).enumerate() {
         let hit =
             box_rows(spans, tri).is_none_or(|[top, end]| top <= last && top.max(end) >= first);
         bits |= u64::from(hit) << k;

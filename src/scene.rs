@@ -333,8 +333,10 @@ impl Scene {
     }
 
     /// Draws every object in its material's colour alone, without its model's vertex
-    /// colours (`bench render --no-vertex-colors`), and plans again. Before any frame
-    /// is made for the scene: its pipelines change.
+    /// colours (`bench render --no-vertex-colors`), and plans again. The colours are
+    /// dropped from the mesh too, as loading drops them for a material without them:
+    /// a mesh holds exactly the attributes its plan transforms. Before any frame is
+    /// made for the scene: its pipelines change.
     pub fn drop_vertex_colors(&mut self) {
         for o in &mut self.objects {
             o.desc.material.vertex_colors = false;

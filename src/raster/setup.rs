@@ -182,8 +182,7 @@ impl Setup {
         debug_assert!(v.iter().flatten().all(|&c| in_band(c)), "{v:?}");
         // The box first: at terminal resolutions many triangles hold no pixel centre.
         let bbox = pixel_bounds(&v, target).ok_or(Reject::Offscreen)?;
-        let [a, b, c] = v;
-        let area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        let area2 = signed_area2(&v);
         if area2 == 0 {
             return Err(Reject::ZeroArea);
         }
@@ -344,6 +343,16 @@ impl Setup {
     }
 }
 
+/// Twice the signed area of snapped vertices `v`, as [`Setup::from_snapped`] finds it:
+/// negative for a triangle counter-clockwise in NDC (y-up), which the set-up marks
+/// [`Setup::flipped`]. `v` must lie within the guard band, which keeps it in `i64`.
+#[must_use]
+#[inline(always)]
+pub(crate) fn signed_area2(v: &[[i64; 2]; 3]) -> i64 {
+    let [a, b, c] = *v;
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
 /// Whether a coordinate in subpixels lies within the guard band (as every one [`snap`]
 /// returns does).
 fn in_band(c: i64) -> bool {
@@ -399,4 +408,36 @@ fn pixel_bounds(v: &[[i64; 2]; 3], target: Target) -> Option<PixelRect> {
         x1: x1 as u32,
         y1: y1 as u32,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    proptest! {
+        /// The sign that culls a back face before its set-up ([`signed_area2`]) is the
+        /// winding the set-up itself finds, and both are the shoelace formula's (in
+        /// `i128`): negative for a triangle counter-clockwise in NDC (y up), a front face.
+        #[test]
+        fn signed_area_gives_the_setups_winding(
+            v in prop::array::uniform3((0i64..64 * SUBPIXEL_ONE, 0i64..48 * SUBPIXEL_ONE)),
+        ) {
+            let v = v.map(|(x, y)| [x, y]);
+            let shoelace: i128 = (0..3)
+                .map(|i| {
+                    let (a, b) = (v[i], v[(i + 1) % 3]);
+                    i128::from(a[0]) * i128::from(b[1]) - i128::from(b[0]) * i128::from(a[1])
+                })
+                .sum();
+            prop_assert_eq!(i128::from(signed_area2(&v)), shoelace);
+            let area = shoelace;
+            match Setup::from_snapped(v, Target::new(64, 48)) {
+                Ok(s) => prop_assert_eq!(s.flipped, area < 0),
+                Err(Reject::ZeroArea) => prop_assert_eq!(area, 0),
+                Err(_) => prop_assert!(area != 0),
+            }
+        }
+    }
 }

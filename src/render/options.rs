@@ -42,7 +42,8 @@ pub struct DrawStats {
     pub triangles: u64,
     /// Triangles that reached the traversal (after clipping, setup and culling).
     pub drawn: u64,
-    /// Back faces skipped.
+    /// Back faces skipped: told by the sign of their area before the rest of the
+    /// set-up, so one that would cover no pixel centre counts here, not as rejected.
     pub culled: u64,
     /// Triangles cut by a clip plane (drawn in part).
     pub clipped: u64,

@@ -13,7 +13,7 @@ use crate::raster::clip::{
     ClipOutcome, ClipVertex, classify_codes, clip_straddling, guard_band_ndc, outcode,
 };
 use crate::raster::interp::{Interpolation, Varying};
-use crate::raster::setup::{box_holds, box_rows, snap};
+use crate::raster::setup::{box_holds, box_rows, signed_area2, snap};
 use crate::raster::{SUBPIXEL_BITS, Setup, Target};
 use crate::simd::each3;
 
@@ -392,13 +392,15 @@ fn setup_piece<V: Varying>(
     if !(pv[0].snapped && pv[1].snapped && pv[2].snapped) {
         return Piece::Rejected;
     }
-    let Ok(setup) = Setup::from_snapped(each3!(|i| pv[i].fixed), target) else {
-        return Piece::Rejected;
-    };
-    // Counter-clockwise in NDC (y-up) is negative area in y-down screen space.
-    if opts.cull == Cull::Back && !setup.flipped {
+    let fixed = each3!(|i| pv[i].fixed);
+    // Counter-clockwise in NDC (y-up) is negative area in y-down screen space. Culled
+    // by the sign alone, before the rest of the set-up: a culled draw skips half of it.
+    if opts.cull == Cull::Back && signed_area2(&fixed) > 0 {
         return Piece::Culled;
     }
+    let Ok(setup) = Setup::from_snapped(fixed, target) else {
+        return Piece::Rejected;
+    };
     let order = |i: usize| if setup.flipped && i > 0 { 3 - i } else { i };
     let var = each3!(|i| *var[order(i)]);
     // The raw value at the box's origin less 256 times the reduced one.

@@ -298,7 +298,8 @@ fn render_plan_and_bad_scene_from_the_command_line() {
 /// and the coloured lit teapot) is drawn by the lane-code Lambert pipeline, one with
 /// vertex colours besides (the sphere's) by its coloured form, and a model's scene has
 /// the bits the model's standard frame had seen the same way (as recorded in
-/// `model_frames`); any other plan takes the packed shader.
+/// `model_frames`); one of a single flat colour (the minimal scene) takes the
+/// flat-colour pipeline; any other plan takes the packed shader.
 #[test]
 fn the_standard_plan_takes_the_lambert_pipeline() {
     let target = Target::new(160, 120);
@@ -321,10 +322,7 @@ fn the_standard_plan_takes_the_lambert_pipeline() {
         assert_eq!(hash, recorded, "{spec}: the frames differ");
     }
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
-    for (file, pipelines) in [
-        ("lit-teapot.toml", ["lambert"]),
-        ("minimal.toml", ["packed"]),
-    ] {
+    for (file, pipelines) in [("lit-teapot.toml", ["lambert"]), ("minimal.toml", ["flat"])] {
         let scene = Scene::load(&examples.join(file)).unwrap();
         assert_eq!(SceneFrame::new(&scene).pipelines(), pipelines, "{file}");
     }

@@ -127,8 +127,8 @@ impl SceneFrame {
     }
 
     /// The shading each object's pipeline draws with: `"lambert"` for the standard
-    /// plan's lane-code Lambert, `"lambert-colors"` for it with vertex colours, else
-    /// `"packed"`.
+    /// plan's lane-code Lambert, `"lambert-colors"` for it with vertex colours,
+    /// `"flat"` for one flat colour, else `"packed"`.
     #[must_use]
     pub fn pipelines(&self) -> Vec<&'static str> {
         self.pipelines.iter().map(|p| p.name()).collect()

@@ -370,7 +370,8 @@ impl<S: Shading> ObjectPipeline for Pipeline<S> {
 
 /// The pipeline for an object of a scene lit by `lights`: the lane-code Lambert when
 /// its plan is exactly the standard one ([`is_standard_lambert`]) or that with vertex
-/// colours ([`is_colored_lambert`]), else the packed
+/// colours ([`is_colored_lambert`]), the flat colour when nothing varies over its
+/// surface ([`is_flat_colour`]), else the packed
 /// shader at the narrowest of [`PACKED_WIDTHS`] that holds its varyings.
 #[must_use]
 pub fn pipeline_for(
@@ -391,6 +392,9 @@ pub fn pipeline_for(
     }
     if is_colored_lambert(obj, plan, lights) {
         return new::<StandardColoredLambert>(varyings);
+    }
+    if is_flat_colour(obj, plan) {
+        return new::<Flat>(varyings);
     }
     match Layout::new(varyings).len {
         0 => new::<Packed<0>>(varyings),

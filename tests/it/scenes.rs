@@ -299,7 +299,8 @@ fn render_plan_and_bad_scene_from_the_command_line() {
 /// vertex colours besides (the sphere's) by its coloured form, and a model's scene has
 /// the bits the model's standard frame had seen the same way (as recorded in
 /// `model_frames`); one of a single flat colour (the minimal scene) takes the
-/// flat-colour pipeline; any other plan takes the packed shader.
+/// flat-colour pipeline, one whose only varying is a colour the interpolated-colour
+/// pipeline; any other plan takes the packed shader.
 #[test]
 fn the_standard_plan_takes_the_lambert_pipeline() {
     let target = Target::new(160, 120);
@@ -333,6 +334,19 @@ fn the_standard_plan_takes_the_lambert_pipeline() {
     )
     .unwrap();
     assert_eq!(SceneFrame::new(&fog).pipelines(), ["packed"]);
+    // A colour interpolated from the vertices, and nothing else on the surface.
+    for material in ["lighting = \"gouraud\"", "vertex_colors = true"] {
+        let text = format!(
+            "[[object]]\nmodel = \"sphere:500\"\n[object.material]\n{material}\n\
+             [object.effects]\ndepth_test = true\n"
+        );
+        let scene = Scene::from_text(&text, Path::new("colour.toml")).unwrap();
+        assert_eq!(
+            SceneFrame::new(&scene).pipelines(),
+            ["vertex-color"],
+            "{text}"
+        );
+    }
     // The sphere without its colours, with them, and lit by lights of the file's own.
     for (material, lights, pipeline) in [
         ("", "", "lambert"),

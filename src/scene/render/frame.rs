@@ -128,7 +128,8 @@ impl SceneFrame {
 
     /// The shading each object's pipeline draws with: `"lambert"` for the standard
     /// plan's lane-code Lambert, `"lambert-colors"` for it with vertex colours,
-    /// `"flat"` for one flat colour, else `"packed"`.
+    /// `"flat"` for one flat colour, `"vertex-color"` for a colour interpolated from
+    /// the vertices, else `"packed"`.
     #[must_use]
     pub fn pipelines(&self) -> Vec<&'static str> {
         self.pipelines.iter().map(|p| p.name()).collect()

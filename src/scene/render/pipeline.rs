@@ -371,7 +371,8 @@ impl<S: Shading> ObjectPipeline for Pipeline<S> {
 /// The pipeline for an object of a scene lit by `lights`: the lane-code Lambert when
 /// its plan is exactly the standard one ([`is_standard_lambert`]) or that with vertex
 /// colours ([`is_colored_lambert`]), the flat colour when nothing varies over its
-/// surface ([`is_flat_colour`]), else the packed
+/// surface ([`is_flat_colour`]), the interpolated colour when only a colour does
+/// ([`is_vertex_colour`]), else the packed
 /// shader at the narrowest of [`PACKED_WIDTHS`] that holds its varyings.
 #[must_use]
 pub fn pipeline_for(
@@ -395,6 +396,9 @@ pub fn pipeline_for(
     }
     if is_flat_colour(obj, plan) {
         return new::<Flat>(varyings);
+    }
+    if is_vertex_colour(obj, plan) {
+        return new::<Interpolated>(varyings);
     }
     match Layout::new(varyings).len {
         0 => new::<Packed<0>>(varyings),

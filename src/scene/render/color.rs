@@ -1,0 +1,298 @@
+//! The pipelines of plain colour, whose fragment stages are lane code: an object
+//! whose every fragment has its material's colour (the minimal scene) is drawn by
+//! [`FlatColor`], one splat per group of pixels; one whose fragments are the material's
+//! colour times a colour interpolated from its vertices (Gouraud or flat lighting,
+//! vertex colours) by [`VertexColor`]. The packed shader would call its fragment stage
+//! once per pixel for either.
+
+use glam::{Mat4, Vec3, Vec4};
+
+use super::{FrameCtx, ObjectShader, Shading};
+use crate::render::shader::{ShadeLanes, Shader};
+use crate::scene::SceneObject;
+use crate::scene::file::TextureMode;
+use crate::scene::plan::{ObjectPlan, VaryingSet};
+use crate::simd::{F32s, each3};
+
+/// Whether every fragment of an object with this plan has its material's colour: it
+/// interpolates nothing, transforms no normal or world position (so the packed shader
+/// would count no work either), and has no fog or depth shading.
+#[must_use]
+pub fn is_flat_colour(obj: &SceneObject, plan: &ObjectPlan) -> bool {
+    plan.varyings == VaryingSet::default()
+        && !plan.normals
+        && !plan.world_positions
+        && !plan.vertex_colors
+        && plan.texture == TextureMode::Off
+        && !plan.fog
+        && obj.desc.effects.fog.is_none()
+        && !plan.depth_shading
+}
+
+/// A shader of one colour.
+pub struct FlatColor<'a> {
+    positions: &'a [Vec3],
+    mvp: Mat4,
+    color: Vec3,
+    /// Whether the three channels are equal ([`ShadeLanes::Grey`]).
+    grey: bool,
+}
+
+impl Shader for FlatColor<'_> {
+    type Varying = ();
+    const LANE_CODE: bool = true;
+
+    #[inline(always)]
+    fn vertex(&self, index: u32) -> (Vec4, ()) {
+        let p = self
+            .positions
+            .get(index as usize)
+            .copied()
+            .unwrap_or(Vec3::ZERO);
+        (self.mvp * p.extend(1.0), ())
+    }
+
+    #[inline(always)]
+    fn fragment(&self, (): &()) -> Vec3 {
+        self.color
+    }
+
+    #[inline(always)]
+    fn fragment_lanes<F: F32s>(&self, _: &[(); 3], _: &[F; 3], _: u32) -> ShadeLanes<F> {
+        let c = self.color;
+        if self.grey {
+            ShadeLanes::Grey(F::splat(c.x))
+        } else {
+            ShadeLanes::Rgb([F::splat(c.x), F::splat(c.y), F::splat(c.z)])
+        }
+    }
+}
+
+/// The pipeline of [`FlatColor`] in the object's material colour.
+pub struct Flat;
+
+impl Shading for Flat {
+    const NAME: &'static str = "flat";
+    type Varying = ();
+    type Instance<'a> = FlatColor<'a>;
+
+    fn shader<'a>(obj: &'a SceneObject, _plan: &'a ObjectPlan, ctx: FrameCtx<'a>) -> FlatColor<'a> {
+        let color = obj.desc.material.color;
+        FlatColor {
+            positions: &obj.mesh.positions,
+            mvp: ctx.view_proj * ctx.model(obj),
+            color,
+            grey: color.x == color.y && color.y == color.z,
+        }
+    }
+}
+
+/// Whether every fragment of an object with this plan is its material's colour times
+/// one interpolated colour, and nothing else: the colour is its only varying (lit per
+/// vertex or per face, or the vertex colours), with no texture, fog or depth shading.
+#[must_use]
+pub fn is_vertex_colour(obj: &SceneObject, plan: &ObjectPlan) -> bool {
+    let color_only = VaryingSet {
+        color: true,
+        ..VaryingSet::default()
+    };
+    plan.varyings == color_only
+        && plan.texture == TextureMode::Off
+        && !plan.fog
+        && obj.desc.effects.fog.is_none()
+        && !plan.depth_shading
+}
+
+/// The packed shader of a colour-only plan ([`is_vertex_colour`]), whose vertex stage
+/// it keeps (lighting per vertex, and the work counters), with lane code for its
+/// fragment stage: the material colour times the interpolated colour.
+pub struct VertexColor<'a> {
+    packed: ObjectShader<'a, 4>,
+    base: Vec3,
+}
+
+impl Shader for VertexColor<'_> {
+    type Varying = [f32; 4];
+    const LANE_CODE: bool = true;
+
+    #[inline(always)]
+    fn vertex(&self, index: u32) -> (Vec4, [f32; 4]) {
+        self.packed.vertex(index)
+    }
+
+    #[inline(always)]
+    fn fragment(&self, v: &[f32; 4]) -> Vec3 {
+        self.packed.fragment(v)
+    }
+
+    /// The colour is the layout's first three floats, interpolated as
+    /// [`Varying::from_relative`](crate::raster::interp::Varying::from_relative) does
+    /// and multiplied by the material colour as [`ObjectShader::fragment`] does.
+    #[inline(always)]
+    fn fragment_lanes<F: F32s>(&self, rel: &[[f32; 4]; 3], w: &[F; 3], _: u32) -> ShadeLanes<F> {
+        // Through `black_box`, the vertex terms are broadcast in each group rather than
+        // hoisted out of the group loop and spilled once per triangle (as in
+        // `ColoredLambert`); `each3!` rather than a closure, which would stay a call
+        // outside the lane copies.
+        let [a, b, c] = *std::hint::black_box(rel);
+        let base = self.base;
+        ShadeLanes::Rgb(each3!(|i| {
+            let v = F::splat(c[i]).mul_add(w[2], F::splat(b[i]).mul_add(w[1], F::splat(a[i])));
+            F::splat(base[i]) * v
+        }))
+    }
+}
+
+/// The pipeline of [`VertexColor`].
+pub struct Interpolated;
+
+impl Shading for Interpolated {
+    const NAME: &'static str = "vertex-color";
+    type Varying = [f32; 4];
+    type Instance<'a> = VertexColor<'a>;
+
+    fn shader<'a>(
+        obj: &'a SceneObject,
+        plan: &'a ObjectPlan,
+        ctx: FrameCtx<'a>,
+    ) -> VertexColor<'a> {
+        let packed = ObjectShader::new(obj, plan, ctx);
+        debug_assert_eq!(packed.layout.color, Some(0));
+        VertexColor {
+            packed,
+            base: obj.desc.material.color,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::camera::Camera;
+    use crate::raster::Target;
+    use crate::render::{DrawOptions, Renderer, Rgba8, VertexCache};
+    use crate::scene::Scene;
+    use crate::scene::render::{Packed, draw_options};
+
+    /// The colour and depth bits of one frame of `scene`'s object drawn by shading `S`
+    /// with the interpolation and traversal of `base`.
+    fn frame<S: Shading>(
+        scene: &Scene,
+        target: Target,
+        base: DrawOptions,
+    ) -> (Vec<[u8; 4]>, Vec<u32>) {
+        let (obj, plan) = (&scene.objects[0], &scene.plan.objects[0]);
+        let cam = Camera::default();
+        let ctx = FrameCtx {
+            view_proj: cam.projection(target.width, target.height, 1.0) * cam.view(),
+            eye: cam.eye,
+            forward: (cam.target - cam.eye).normalize(),
+            lights: &scene.lights,
+            depth_range: (1.0, 4.0),
+            time: 0.7,
+            turn: None,
+        };
+        let shader = S::shader(obj, plan, ctx);
+        let mut r = Renderer::new(target);
+        let mut color = Rgba8::default();
+        r.begin_frame(target, &mut color, Vec3::ZERO);
+        let mut cache = VertexCache::default();
+        r.transform(&shader, obj.mesh.positions.len(), &mut cache);
+        let opts = draw_options(plan, base);
+        r.draw(&shader, &cache, &obj.mesh.indices, &opts, &mut color);
+        let depth = r.depth.to_vec().iter().map(|d| d.to_bits()).collect();
+        (color.0, depth)
+    }
+
+    /// Pass: an object of one flat colour takes this pipeline, and it draws the bits
+    /// the packed shader draws for it, in grey and in colour, with and without a depth
+    /// test, culled or not.
+    #[test]
+    fn flat_colour_draws_the_packed_shaders_bits() {
+        let target = Target::new(96, 64);
+        for (color, effects) in [
+            ("", "depth_test = true"),
+            (
+                "color = [0.9, 0.4, 0.1]\n",
+                "depth_test = true\ncull = true",
+            ),
+            ("color = [0.2, 0.7, 0.5]\n", ""),
+        ] {
+            let text = format!(
+                "[[object]]\nmodel = \"teapot\"\nrotation = [30, 20, 0]\n\
+                 [object.material]\n{color}[object.effects]\n{effects}\n"
+            );
+            let scene = Scene::from_text(&text, Path::new("flat.toml")).unwrap();
+            assert!(
+                is_flat_colour(&scene.objects[0], &scene.plan.objects[0]),
+                "{text}"
+            );
+            let base = DrawOptions::default();
+            let flat = frame::<Flat>(&scene, target, base);
+            let packed = frame::<Packed<0>>(&scene, target, base);
+            assert!(
+                flat.0.iter().filter(|p| p[3] == 255).count() > 500,
+                "{text}"
+            );
+            assert_eq!(flat, packed, "{text}");
+        }
+    }
+
+    /// Pass: an object whose only varying is a colour (lit per vertex or per face, or
+    /// its vertex colours) takes the interpolated-colour pipeline, and it draws the
+    /// bits the packed shader draws for it, in every interpolation mode, culled or not.
+    #[test]
+    fn vertex_colour_draws_the_packed_shaders_bits() {
+        use crate::raster::interp::Interpolation;
+        let target = Target::new(96, 64);
+        for (model, material, effects) in [
+            (
+                "sphere:2000",
+                "lighting = \"gouraud\"\n",
+                "depth_test = true",
+            ),
+            (
+                "teapot",
+                "lighting = \"flat\"\ncolor = [0.9, 0.4, 0.1]\n",
+                "depth_test = true\ncull = true",
+            ),
+            ("sphere:2000", "vertex_colors = true\n", "depth_test = true"),
+            (
+                "sphere:2000",
+                "lighting = \"gouraud\"\nvertex_colors = true\n",
+                "",
+            ),
+        ] {
+            let text = format!(
+                "[[object]]\nmodel = \"{model}\"\nrotation = [30, 20, 0]\n\
+                 [object.material]\n{material}[object.effects]\n{effects}\n"
+            );
+            let scene = Scene::from_text(&text, Path::new("colour.toml")).unwrap();
+            assert!(
+                is_vertex_colour(&scene.objects[0], &scene.plan.objects[0]),
+                "{text}"
+            );
+            for interpolation in [
+                Interpolation::Perspective,
+                Interpolation::Perspective4,
+                Interpolation::Affine,
+            ] {
+                let base = DrawOptions {
+                    interpolation,
+                    ..DrawOptions::default()
+                };
+                let lanes = frame::<Interpolated>(&scene, target, base);
+                let packed = frame::<Packed<4>>(&scene, target, base);
+                let covered: Vec<_> = lanes.0.iter().filter(|p| p[3] == 255).collect();
+                assert!(covered.len() > 500, "{text}");
+                let mut colours = covered.clone();
+                colours.sort_unstable();
+                colours.dedup();
+                assert!(colours.len() > 20, "{text}: {} colours", colours.len());
+                assert_eq!(lanes, packed, "{text} {interpolation:?}");
+            }
+        }
+    }
+}

@@ -110,7 +110,8 @@ fn every_option() -> Vec<(Interpolation, Traversal, Isa)> {
 }
 
 /// Models (the lane-code Lambert pipeline) and scene files (the packed pipelines,
-/// textures, depth shading, several objects, culling) at a size of several bands
+/// textures, depth shading, several objects, culling; the flat colour without a depth
+/// buffer; the interpolated colour of flat lighting) at a size of several bands
 /// whose height is not a multiple of one: every option on 2 and 3 threads gives the
 /// frame and counters of 1 thread.
 #[test]
@@ -123,6 +124,7 @@ fn threaded_frames_equal_one_thread_for_every_model_option_and_isa() {
         ("textured-cube", scene_file("textured-cube.toml")),
         ("depth-map", scene_file("depth-map.toml")),
         ("silhouettes", scene_file("silhouettes.toml")),
+        ("minimal", scene_file("minimal.toml")),
     ];
     for (name, scene) in &scenes {
         let view = turned(0.9);

@@ -90,6 +90,21 @@ impl Tmux {
         }
     }
 
+    /// The screen once `done` holds for it and two captures 100 ms apart are the same
+    /// (a frame is not caught half written), or after ten seconds.
+    fn wait_settled(&self, done: impl Fn(&str) -> bool) -> String {
+        let start = Instant::now();
+        let mut last = String::new();
+        loop {
+            let s = self.screen();
+            if (done(&s) && s == last) || start.elapsed() > Duration::from_secs(10) {
+                return s;
+            }
+            last = s;
+            sleep(Duration::from_millis(100));
+        }
+    }
+
     /// The screen once the shell has printed the viewer's exit status (the `EXIT=`
     /// in the typed command line does not count).
     fn wait_for_exit(&self) -> String {

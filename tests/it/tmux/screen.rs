@@ -75,7 +75,8 @@ fn panel_fields_are_never_split() {
         };
         t.start_viewer();
         t.keys(&["i"]);
-        let s = t.wait_for("overdraw");
+        // The whole panel, and not a frame caught half written.
+        let s = t.wait_settled(|s| s.contains("overdraw") && s.contains("incrNE"));
         // Each label has its values beside it, on the same row.
         for (label, values) in [
             ("area2", 1),

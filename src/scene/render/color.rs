@@ -15,18 +15,21 @@ use crate::scene::plan::{ObjectPlan, VaryingSet};
 use crate::simd::{F32s, each3};
 
 /// Whether every fragment of an object with this plan has its material's colour: it
-/// interpolates nothing, transforms no normal or world position (so the packed shader
-/// would count no work either), and has no fog or depth shading.
+/// interpolates nothing, so it has no lighting, vertex colours, texture, fog or depth
+/// shading (each needs a varying), and transforms no normal or world position (so the
+/// packed shader would count no work either).
 #[must_use]
-pub fn is_flat_colour(obj: &SceneObject, plan: &ObjectPlan) -> bool {
+pub fn is_flat_colour(plan: &ObjectPlan) -> bool {
     plan.varyings == VaryingSet::default()
         && !plan.normals
         && !plan.world_positions
-        && !plan.vertex_colors
-        && plan.texture == TextureMode::Off
-        && !plan.fog
-        && obj.desc.effects.fog.is_none()
-        && !plan.depth_shading
+        && plain_surface(plan)
+}
+
+/// No texture, fog or depth shading: nothing on the surface but the material colour
+/// and what the varyings carry.
+fn plain_surface(plan: &ObjectPlan) -> bool {
+    plan.texture == TextureMode::Off && !plan.fog && !plan.depth_shading
 }
 
 /// A shader of one colour.
@@ -91,16 +94,12 @@ impl Shading for Flat {
 /// one interpolated colour, and nothing else: the colour is its only varying (lit per
 /// vertex or per face, or the vertex colours), with no texture, fog or depth shading.
 #[must_use]
-pub fn is_vertex_colour(obj: &SceneObject, plan: &ObjectPlan) -> bool {
+pub fn is_vertex_colour(plan: &ObjectPlan) -> bool {
     let color_only = VaryingSet {
         color: true,
         ..VaryingSet::default()
     };
-    plan.varyings == color_only
-        && plan.texture == TextureMode::Off
-        && !plan.fog
-        && obj.desc.effects.fog.is_none()
-        && !plan.depth_shading
+    plan.varyings == color_only && plain_surface(plan)
 }
 
 /// The packed shader of a colour-only plan ([`is_vertex_colour`]), whose vertex stage
@@ -225,10 +224,7 @@ mod tests {
                  [object.material]\n{color}[object.effects]\n{effects}\n"
             );
             let scene = Scene::from_text(&text, Path::new("flat.toml")).unwrap();
-            assert!(
-                is_flat_colour(&scene.objects[0], &scene.plan.objects[0]),
-                "{text}"
-            );
+            assert!(is_flat_colour(&scene.plan.objects[0]), "{text}");
             let base = DrawOptions::default();
             let flat = frame::<Flat>(&scene, target, base);
             let packed = frame::<Packed<0>>(&scene, target, base);
@@ -270,10 +266,7 @@ mod tests {
                  [object.material]\n{material}[object.effects]\n{effects}\n"
             );
             let scene = Scene::from_text(&text, Path::new("colour.toml")).unwrap();
-            assert!(
-                is_vertex_colour(&scene.objects[0], &scene.plan.objects[0]),
-                "{text}"
-            );
+            assert!(is_vertex_colour(&scene.plan.objects[0]), "{text}");
             for interpolation in [
                 Interpolation::Perspective,
                 Interpolation::Perspective4,

@@ -9,11 +9,11 @@
 //! which keeps the build small. An object whose plan is exactly the standard one
 //! (per-pixel Lambert under the standard lights, depth-tested, nothing else: what a
 //! model is) is drawn with the lane-code [`Lambert`](crate::render::shaders::Lambert)
-//! instead ([`is_standard_lambert`]), one of a single flat colour with
-//! [`FlatColor`] ([`is_flat_colour`]) and one of a colour interpolated from its
-//! vertices with [`VertexColor`] ([`is_vertex_colour`]). The choice is made once per object (a trait
-//! object per object, called once per frame); nothing is dispatched per vertex or
-//! pixel.
+//! instead ([`is_standard_lambert`]), one of a single flat colour with [`FlatColor`]
+//! ([`is_flat_colour`]) and one of a colour interpolated from its vertices with
+//! [`VertexColor`] ([`is_vertex_colour`]). The choice is made once per object (a
+//! trait object per object, called once per frame); nothing is dispatched per vertex
+//! or pixel.
 
 mod color;
 mod frame;

@@ -394,10 +394,10 @@ pub fn pipeline_for(
     if is_colored_lambert(obj, plan, lights) {
         return new::<StandardColoredLambert>(varyings);
     }
-    if is_flat_colour(obj, plan) {
+    if is_flat_colour(plan) {
         return new::<Flat>(varyings);
     }
-    if is_vertex_colour(obj, plan) {
+    if is_vertex_colour(plan) {
         return new::<Interpolated>(varyings);
     }
     match Layout::new(varyings).len {

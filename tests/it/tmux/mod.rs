@@ -93,16 +93,12 @@ impl Tmux {
     /// The screen once `done` holds for it and two captures 100 ms apart are the same
     /// (a frame is not caught half written), or after ten seconds.
     fn wait_settled(&self, done: impl Fn(&str) -> bool) -> String {
-        let start = Instant::now();
-        let mut last = String::new();
-        loop {
-            let s = self.screen();
-            if (done(&s) && s == last) || start.elapsed() > Duration::from_secs(10) {
-                return s;
-            }
-            last = s;
-            sleep(Duration::from_millis(100));
-        }
+        let last = std::cell::RefCell::new(String::new());
+        self.wait_until(|s| {
+            let same = *last.borrow() == s;
+            *last.borrow_mut() = s.to_string();
+            same && done(s)
+        })
     }
 
     /// The screen once the shell has printed the viewer's exit status (the `EXIT=`

@@ -9,6 +9,7 @@ mod bench_runs;
 mod bytes;
 mod cli_mistakes;
 mod cli_raster;
+mod colour_pipelines;
 mod coverage;
 mod formats;
 mod framing;

@@ -141,7 +141,7 @@ impl SceneFrame {
         let triangles: usize = scene.objects.iter().map(|o| o.mesh.triangle_count()).sum();
         self.renderer.plan_frame(
             target.len() as u64 * side + crate::render::TRIANGLE_WORK * triangles as u64,
-            self.draw_kind(scene),
+            draw_kind(scene, self.interpolation, self.traversal),
         );
         let start = Instant::now();
         match self.renderer.pool().cloned() {
@@ -151,19 +151,6 @@ impl SceneFrame {
             None => self.draw_here(scene, target, view),
         }
         self.renderer.frame_took(start.elapsed());
-    }
-
-    /// What tells frames of one amount of work apart for the renderer's measured
-    /// choice ([`Renderer::plan_frame`]): the interpolation and traversal, and what
-    /// each object draws (triangles, edges) and culls (the viewer's `w` and `b`).
-    fn draw_kind(&self, scene: &Scene) -> u64 {
-        let mut h = DefaultHasher::new();
-        (self.interpolation, self.traversal).hash(&mut h);
-        for o in &scene.objects {
-            let e = &o.desc.effects;
-            (e.fill, e.wireframe, e.cull).hash(&mut h);
-        }
-        h.finish()
     }
 
     /// [`SceneFrame::draw`] on the calling thread.
@@ -419,10 +406,24 @@ fn resolve(fine: &Rgba8, ft: Target, side: u32, out: &mut Rgba8, target: Target,
     }
 }
 
+/// What tells frames of one amount of work apart for the renderer's measured choice
+/// ([`Renderer::plan_frame`]): the interpolation and traversal, and what each object
+/// draws (triangles, edges) and culls (the viewer's `w` and `b`).
+fn draw_kind(scene: &Scene, interpolation: Interpolation, traversal: Traversal) -> u64 {
+    let mut h = DefaultHasher::new();
+    (interpolation, traversal).hash(&mut h);
+    for o in &scene.objects {
+        let e = &o.desc.effects;
+        (e.fill, e.wireframe, e.cull).hash(&mut h);
+    }
+    h.finish()
+}
+
 #[cfg(test)]
 mod tests {
-    use super::SceneFrame;
+    use super::draw_kind;
     use crate::raster::Traversal;
+    use crate::raster::interp::Interpolation;
     use crate::scene::{Mode, Scene};
 
     /// Frames drawn differently have different kinds, so the measured choice starts
@@ -430,21 +431,25 @@ mod tests {
     #[test]
     fn a_change_in_drawing_changes_the_kind() {
         let mut scene = Scene::standard("teapot").expect("the built-in teapot");
-        let mut frame = SceneFrame::new(&scene);
-        let fill = frame.draw_kind(&scene);
-        assert_eq!(frame.draw_kind(&scene), fill);
+        let wide = |scene: &Scene| draw_kind(scene, Interpolation::Perspective, Traversal::Wide);
+        let fill = wide(&scene);
+        assert_eq!(wide(&scene), fill);
         let mut kinds = vec![fill];
         for mode in [Mode::Wire, Mode::FillWire] {
             scene.set_mode(mode);
-            kinds.push(frame.draw_kind(&scene));
+            kinds.push(wide(&scene));
         }
         scene.set_mode(Mode::Fill);
-        assert_eq!(frame.draw_kind(&scene), fill, "back to triangles");
+        assert_eq!(wide(&scene), fill, "back to triangles");
         scene.set_cull(true);
-        kinds.push(frame.draw_kind(&scene));
+        kinds.push(wide(&scene));
         scene.set_cull(false);
-        frame.traversal = Traversal::Scalar;
-        kinds.push(frame.draw_kind(&scene));
+        kinds.push(draw_kind(
+            &scene,
+            Interpolation::Perspective,
+            Traversal::Scalar,
+        ));
+        kinds.push(draw_kind(&scene, Interpolation::Affine, Traversal::Wide));
         let mut distinct = kinds.clone();
         distinct.sort_unstable();
         distinct.dedup();
